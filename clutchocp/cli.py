@@ -1,0 +1,81 @@
+"""The ``clutchocp`` command: a thin layer over the Python API.
+
+Every user mistake ends in one line on stderr naming the field and what is allowed, exit code 2.
+"""
+
+import argparse
+import sys
+from pathlib import Path
+
+from .errors import ClutchocpError
+
+
+def _cmd_scenes(args):
+    from .scene import list_scenes, load_scene
+
+    if args.scene:
+        for name in args.scene:
+            _describe(load_scene(name))
+        return 0
+    scenes = list_scenes()
+    width = max(len(s.name) for s in scenes)
+    for scene in scenes:
+        mark = " (default)" if scene.value("scene.default") else ""
+        print(f"{scene.name:<{width}}  {scene.kind:<10}  {scene.title}{mark}")
+    return 0
+
+
+def _describe(scene):
+    """Print a checked scene: its parts and their chosen variants."""
+    print(f"{scene.name}: {scene.kind} scene, valid")
+    print(f"  source: {scene.source}")
+    for part in scene.parts:
+        if part != "scene":
+            variant = scene.variant(part)
+            print(f"  [{part}]" + (f" model = {variant}" if variant else ""))
+
+
+def _cmd_validate(args):
+    from .analyses import run_validation
+
+    run_validation(Path(args.out))
+    return 0
+
+
+def build_parser():
+    """The argument parser of the ``clutchocp`` command."""
+    parser = argparse.ArgumentParser(
+        prog="clutchocp",
+        description="Wet-clutch and hydro-viscous-drive simulation, optimal engagement pressure and control.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    p = sub.add_parser("scenes", help="list the built-in scenes, one line each; or check the scenes named")
+    p.add_argument("scene", nargs="*", help="scene name or TOML file to check and describe")
+    p.set_defaults(run=_cmd_scenes)
+    p = sub.add_parser("validate", help="static analyses against the seed papers' tables (Chen, Cui, Liao)")
+    p.add_argument("--out", default="out/validate", help="output folder (default: out/validate)")
+    p.set_defaults(run=_cmd_validate)
+    return parser
+
+
+def main(argv=None):
+    """Entry point; returns the process exit code."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.run(args)
+    except ClutchocpError as exc:
+        print(f"clutchocp {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("clutchocp: interrupted", file=sys.stderr)
+        return 130
+
+
+
+def run():
+    """Console-script entry point: exit with :func:`main`'s code."""
+    sys.exit(main())
+
+
+if __name__ == "__main__":
+    run()

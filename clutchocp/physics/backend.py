@@ -1,0 +1,69 @@
+"""Elementary functions that work on floats, numpy arrays and CasADi SX/MX/DM alike.
+
+Physics components call these instead of ``numpy`` or ``casadi`` directly, so one
+formula serves the numeric analyses, the DAE and the optimal-control problem.
+"""
+
+import casadi as ca
+import numpy as np
+from scipy import special
+
+_CASADI_TYPES = (ca.SX, ca.MX, ca.DM)
+
+
+def is_symbolic(*args):
+    """True if any argument is a CasADi SX, MX or DM (then CasADi operators are used)."""
+    return any(isinstance(a, _CASADI_TYPES) for a in args)
+
+
+def exp(x):
+    return ca.exp(x) if is_symbolic(x) else np.exp(x)
+
+
+def log(x):
+    return ca.log(x) if is_symbolic(x) else np.log(x)
+
+
+def sqrt(x):
+    return ca.sqrt(x) if is_symbolic(x) else np.sqrt(x)
+
+
+def tanh(x):
+    return ca.tanh(x) if is_symbolic(x) else np.tanh(x)
+
+
+def erf(x):
+    return ca.erf(x) if is_symbolic(x) else special.erf(x)
+
+
+def fabs(x):
+    return ca.fabs(x) if is_symbolic(x) else np.abs(x)
+
+
+def fmax(a, b):
+    return ca.fmax(a, b) if is_symbolic(a, b) else np.maximum(a, b)
+
+
+def fmin(a, b):
+    return ca.fmin(a, b) if is_symbolic(a, b) else np.minimum(a, b)
+
+
+def if_else(cond, if_true, if_false):
+    """Elementwise choice; with CasADi both branches are evaluated (keep them finite)."""
+    if is_symbolic(cond, if_true, if_false):
+        return ca.if_else(cond, if_true, if_false)
+    return np.where(cond, if_true, if_false)
+
+
+def softplus(x, width):
+    """Smooth ``max(x, 0)``: ``width * log(1 + exp(x / width))``, overflow-safe.
+
+    The error against ``max(x, 0)`` is at most ``width * ln 2`` (at x = 0).
+    """
+    z = x / width
+    return width * (fmax(z, 0) + log(1 + exp(-fabs(z))))
+
+
+def smooth_step(x, width):
+    """Smooth Heaviside step: 0.5 (1 + tanh(x / width)); equals 0.5 at x = 0."""
+    return 0.5 * (1 + tanh(x / width))

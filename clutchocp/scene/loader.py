@@ -1,0 +1,352 @@
+"""Load, validate and override scene files.
+
+``load_scene("bao2020")`` finds a built-in scene by name; ``load_scene("my/clutch.toml")`` reads a
+file.  Validation turns every user mistake into one :class:`~clutchocp.errors.SceneError` line that
+names the field and what is allowed.
+"""
+
+import difflib
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import (
+    MissingParameterError,
+    ParameterTypeError,
+    PhysicalRangeError,
+    SceneError,
+    SceneNotFoundError,
+    UnknownKeyError,
+    UnknownVariantError,
+)
+from ..units import to_si
+from .schema import CHECKS, PARTS, REQUIRED_PARTS
+
+# Parts each static analysis reads.
+ANALYSIS_PARTS = {
+    "chen2021_pack": ("spline", "friction", "operating"),
+    "cui2019_mixed": ("roughness", "contact", "friction", "oil", "operating"),
+    "liao2021_hvc": ("groove", "hvc", "oil", "operating"),
+}
+
+
+def builtin_scene_dir():
+    """Folder of the built-in scenes: inside the installed package, or models/ of a source tree."""
+    package = Path(__file__).resolve().parent.parent
+    installed = package / "_data" / "models"
+    return installed if installed.is_dir() else package.parent / "models"
+
+
+def _suggest(word, options):
+    close = difflib.get_close_matches(word, list(options), n=1, cutoff=0.5)
+    return f"; did you mean '{close[0]}'?" if close else ""
+
+
+def _check_value(name, value, spec, unit_hint):
+    ok, phrase = CHECKS[spec.check]
+    if not math.isfinite(value):
+        raise PhysicalRangeError(f"{name} = {value}: must be a finite number {phrase}")
+    if not ok(value):
+        raise PhysicalRangeError(f"{name} = {value:g}{unit_hint}: must be {phrase}")
+
+
+def _parse_field(name, raw, spec):
+    """Convert one raw TOML value to its SI value, or raise a one-line SceneError."""
+    unit_hint = "" if spec.dim == "1" else f" (SI, {spec.dim})"
+    if spec.kind == "quantity":
+        if isinstance(raw, (list, dict)):
+            raise ParameterTypeError(f"{name}: expected one number or quantity in {spec.dim}, got a {type(raw).__name__}")
+        value = to_si(raw, spec.dim, name)
+        _check_value(name, value, spec, unit_hint)
+        return value
+    if spec.kind == "quantity_list":
+        items = raw if isinstance(raw, list) else [raw]
+        if not items:
+            raise ParameterTypeError(f"{name}: expected at least one value in {spec.dim}")
+        values = []
+        for i, item in enumerate(items):
+            if isinstance(item, (list, dict)):
+                raise ParameterTypeError(f"{name}[{i}]: expected a number or quantity in {spec.dim}")
+            value = to_si(item, spec.dim, f"{name}[{i}]")
+            _check_value(f"{name}[{i}]", value, spec, unit_hint)
+            values.append(value)
+        return np.array(values)
+    if spec.kind == "int":
+        if isinstance(raw, bool) or not isinstance(raw, int):
+            raise ParameterTypeError(f"{name}: expected a whole number, got {raw!r}")
+        _check_value(name, raw, spec, "")
+        return raw
+    if spec.kind == "bool":
+        if not isinstance(raw, bool):
+            raise ParameterTypeError(f"{name}: expected true or false, got {raw!r}")
+        return raw
+    if spec.kind == "str":
+        if not isinstance(raw, str):
+            raise ParameterTypeError(f"{name}: expected text, got {raw!r}")
+        return raw
+    if spec.kind == "str_list":
+        if not isinstance(raw, list) or not all(isinstance(x, str) for x in raw):
+            raise ParameterTypeError(f"{name}: expected a list of text lines")
+        return tuple(raw)
+    if spec.kind == "choice":
+        if raw not in spec.choices:
+            raise UnknownVariantError(f"{name} = {raw!r}: allowed values are {', '.join(spec.choices)}")
+        return raw
+    raise AssertionError(f"schema error: unknown field kind {spec.kind}")
+
+
+def _validate_part(part_name, table):
+    part = PARTS[part_name]
+    if not isinstance(table, dict):
+        raise ParameterTypeError(f"[{part_name}]: expected a table of parameters, got {table!r}")
+    values = {}
+    variant = ""
+    if part.variants:
+        variant = table.get("model", part.default_variant)
+        if variant not in part.variants:
+            raise UnknownVariantError(
+                f"{part_name}.model = {variant!r}: unknown variant; allowed: {', '.join(part.variants)}"
+                + (_suggest(variant, part.variants) if isinstance(variant, str) else "")
+            )
+        values["model"] = variant
+    allowed = part.allowed_fields(variant)
+    for key in table:
+        if key == "model" and part.variants:
+            continue
+        if key not in allowed:
+            where = f"{part_name} (model = {variant})" if variant else part_name
+            options = sorted(allowed) + (["model"] if part.variants else [])
+            raise UnknownKeyError(
+                f"{part_name}.{key}: unknown key in [{where}]{_suggest(key, options)} "
+                f"(allowed: {', '.join(options)})"
+            )
+    for key, spec in allowed.items():
+        name = f"{part_name}.{key}"
+        if key in table:
+            values[key] = _parse_field(name, table[key], spec)
+        elif spec.required:
+            raise MissingParameterError(f"{name}: missing required parameter ({spec.doc})")
+        elif spec.default is not None:
+            values[key] = spec.default
+    return values
+
+
+def _require(values, name, why):
+    part, key = name.split(".")
+    if key not in values.get(part, {}):
+        raise MissingParameterError(f"{name}: missing, required {why}")
+
+
+def _cross_check(values, base_dir):
+    """Checks that involve more than one field."""
+    kind = values["scene"]["kind"]
+    for part in REQUIRED_PARTS[kind]:
+        if part not in values:
+            raise MissingParameterError(f"[{part}]: missing part, required for a scene of kind '{kind}'")
+    analysis = values["scene"].get("analysis")
+    for part in ANALYSIS_PARTS.get(analysis, ()):
+        if part not in values:
+            raise MissingParameterError(f"[{part}]: missing part, required by analysis '{analysis}'")
+    plates = values["plates"]
+    if plates["r_inner"] >= plates["r_outer"]:
+        raise PhysicalRangeError(
+            f"plates.r_inner = {plates['r_inner']:g} m must be smaller than plates.r_outer = {plates['r_outer']:g} m"
+        )
+    rough = values.get("roughness")
+    if rough is not None:
+        if "sigma" not in rough:
+            if "sigma_1" not in rough or "sigma_2" not in rough:
+                raise MissingParameterError("roughness.sigma: missing (give sigma, or both sigma_1 and sigma_2)")
+            rough["sigma"] = math.hypot(rough["sigma_1"], rough["sigma_2"])
+        elif "sigma_1" in rough or "sigma_2" in rough:
+            raise SceneError("roughness.sigma: give either sigma or sigma_1 and sigma_2, not both")
+    contact = values.get("contact", {}).get("model")
+    if contact and contact != "none":
+        for key in ("asperity_density", "asperity_radius"):
+            _require(values, f"roughness.{key}", f"by contact model '{contact}'")
+        if values["roughness"]["sigma"] <= 0:
+            raise PhysicalRangeError(f"roughness.sigma = 0: must be > 0 with contact model '{contact}'")
+    friction = values.get("friction", {})
+    if friction.get("model") == "table":
+        p, mu = friction["pressure"], friction["mu"]
+        if len(p) != len(mu) or len(p) < 2:
+            raise SceneError("friction.mu: give one value per friction.pressure entry, at least two")
+        if np.any(np.diff(p) <= 0):
+            raise PhysicalRangeError("friction.pressure: values must increase strictly")
+    pack = values.get("pack", {})
+    if pack.get("model") == "masses" and len(pack["plate_masses"]) != plates["n_interfaces"]:
+        raise SceneError(
+            f"pack.plate_masses: give {plates['n_interfaces']} masses, one per film (plates.n_interfaces), "
+            f"got {len(pack['plate_masses'])}"
+        )
+    drive = values.get("driveline", {})
+    if drive.get("input") == "inertia":
+        _require(values, "driveline.input_inertia", "when driveline.input = 'inertia'")
+    if drive.get("output") == "inertia":
+        _require(values, "driveline.output_inertia", "when driveline.output = 'inertia'")
+    if drive.get("input") == "prescribed_speed" and drive.get("output") == "fixed":
+        raise SceneError("driveline.output = 'fixed' needs driveline.input = 'inertia' (something must slow down)")
+    act = values.get("actuation", {})
+    if "max_pressure" in act and act["max_pressure"] < act["pressure"]:
+        raise PhysicalRangeError(
+            f"actuation.pressure = {act['pressure']:g} Pa exceeds actuation.max_pressure = {act['max_pressure']:g} Pa"
+        )
+    for part in ("actuation", "load"):
+        if values.get(part, {}).get("model") == "table":
+            path = (base_dir / values[part]["file"]).resolve()
+            if not path.is_file():
+                raise SceneNotFoundError(f"{part}.file: no file '{values[part]['file']}' next to the scene")
+            values[part]["file"] = str(path)
+    piston = values.get("piston")
+    if piston is not None and piston["model"] == "spring_applied" and piston["spring_stiffness"] <= 0:
+        raise PhysicalRangeError("piston.spring_stiffness: must be > 0 for a spring-applied piston")
+
+
+class Scene:
+    """A validated scene: the parts it declares and their parameters in SI.
+
+    Use :meth:`value` for a parameter (``scene.value("plates.r_inner")``), :meth:`has` to ask
+    whether a part is present, :meth:`variant` for a part's chosen model.
+    """
+
+    def __init__(self, raw, path=None):
+        self.raw = raw
+        self.path = Path(path) if path else None
+        try:
+            self._values = validate(raw, self.path.parent if self.path else Path.cwd())
+        except SceneError as exc:
+            if self.path is None:
+                raise
+            raise type(exc)(f"{self.path.name}: {exc}") from None
+
+    @property
+    def name(self):
+        return self._values["scene"]["name"]
+
+    @property
+    def title(self):
+        return self._values["scene"].get("title", "")
+
+    @property
+    def source(self):
+        return self._values["scene"]["source"]
+
+    @property
+    def kind(self):
+        return self._values["scene"]["kind"]
+
+    @property
+    def parts(self):
+        """Names of the parts this scene declares."""
+        return tuple(self._values)
+
+    def has(self, part):
+        """True if the scene declares ``part`` (and, for a variant part, not ``model = "none"``)."""
+        return part in self._values and self._values[part].get("model") != "none"
+
+    def variant(self, part):
+        """The chosen ``model`` of a part with variants."""
+        return self._values[part].get("model", "")
+
+    def value(self, name):
+        """SI value of ``"part.key"``; raises MissingParameterError if the scene lacks it."""
+        part, _, key = name.partition(".")
+        try:
+            return self._values[part][key]
+        except KeyError:
+            raise MissingParameterError(f"{name}: not given in scene '{self.name}'") from None
+
+    def get(self, name, default=None):
+        """SI value of ``"part.key"``, or ``default`` if absent."""
+        part, _, key = name.partition(".")
+        return self._values.get(part, {}).get(key, default)
+
+    def with_overrides(self, overrides):
+        """A new scene with ``{"part.key": value}`` replaced (values as in a scene file)."""
+        raw = {part: dict(table) if isinstance(table, dict) else table for part, table in self.raw.items()}
+        for name, value in overrides.items():
+            part, dot, key = name.partition(".")
+            if not dot or not key:
+                raise UnknownKeyError(f"{name}: an override is written part.key=value (e.g. oil.viscosity=0.04)")
+            if part not in PARTS:
+                raise UnknownKeyError(f"{name}: unknown part '{part}'{_suggest(part, PARTS)}")
+            raw.setdefault(part, {})[key] = value
+        return Scene(raw, self.path)
+
+    def __repr__(self):
+        return f"Scene({self.name!r}, kind={self.kind!r}, parts={list(self.parts)})"
+
+
+def validate(raw, base_dir):
+    """Validate a parsed scene dictionary; return {part: {key: SI value}}."""
+    if not isinstance(raw, dict):
+        raise ParameterTypeError("scene: expected TOML tables")
+    for part in raw:
+        if part not in PARTS:
+            raise UnknownKeyError(f"[{part}]: unknown part{_suggest(part, PARTS)} (allowed: {', '.join(PARTS)})")
+    if "scene" not in raw:
+        raise MissingParameterError("[scene]: missing part (name, source and kind are required)")
+    values = {part: _validate_part(part, table) for part, table in raw.items()}
+    _cross_check(values, base_dir)
+    return values
+
+
+def parse_override(text):
+    """Parse ``"part.key=value"`` from the command line; the value is read as TOML if it can be."""
+    name, eq, value = text.partition("=")
+    if not eq:
+        raise UnknownKeyError(f"--set {text}: write part.key=value (e.g. oil.viscosity='0.04 Pa s')")
+    try:
+        parsed = tomllib.loads(f"v = {value.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        parsed = value.strip()
+    return name.strip(), parsed
+
+
+def load_scene(name_or_path, overrides=None):
+    """Load a scene by built-in name (see :func:`list_scenes`) or by file path.
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path
+        A built-in scene name such as ``"bao2020"`` or a path to a TOML file.
+    overrides : dict, optional
+        ``{"part.key": value}`` replacing values of the file.
+
+    Returns
+    -------
+    Scene
+    """
+    path = Path(name_or_path)
+    if not path.is_file():
+        candidate = builtin_scene_dir() / f"{name_or_path}.toml"
+        if not candidate.is_file():
+            names = [s.stem for s in builtin_scene_dir().glob("*.toml")]
+            raise SceneNotFoundError(
+                f"scene '{name_or_path}': no such file and no built-in scene of that name"
+                f"{_suggest(str(name_or_path), names)} (built-in: {', '.join(sorted(names))})"
+            )
+        path = candidate
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path.name}: not valid TOML ({exc})") from None
+    except UnicodeDecodeError:
+        raise SceneError(f"{path.name}: not a UTF-8 text file") from None
+    scene = Scene(raw, path)
+    return scene.with_overrides(overrides) if overrides else scene
+
+
+def list_scenes():
+    """All built-in scenes, sorted by name."""
+    return [load_scene(p) for p in sorted(builtin_scene_dir().glob("*.toml"))]
+
+
+def default_scene():
+    """The built-in scene marked ``default = true`` (the engagement-optimisation default)."""
+    defaults = [s for s in list_scenes() if s.value("scene.default")]
+    if len(defaults) != 1:
+        raise SceneError(f"built-in scenes: expected exactly one default scene, found {len(defaults)}")
+    return defaults[0]

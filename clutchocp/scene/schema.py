@@ -1,0 +1,325 @@
+"""The scene format: which parts a scene may declare and the parameters of each.
+
+A scene file is TOML.  Each table is a *part* (``[plates]``, ``[oil]``, ``[piston]`` ...).  A part
+with variants chooses one with ``model = "..."``; the variant decides which parameters exist.
+Quantities may carry units (``"8.4 um"``); plain numbers are SI.  Parts marked optional may be
+left out: the model then compiles without them (no states, no equations, no cost).
+"""
+
+from dataclasses import dataclass, field as dc_field
+
+# Value checks: name -> (predicate on the SI value, phrase for the error message).
+CHECKS = {
+    "positive": (lambda v: v > 0, "> 0"),
+    "nonnegative": (lambda v: v >= 0, ">= 0"),
+    "fraction": (lambda v: 0 < v <= 1, "in (0, 1]"),
+    "unit_interval": (lambda v: 0 <= v <= 1, "in [0, 1]"),
+    "fractal_dimension": (lambda v: 1 < v < 2, "in (1, 2)"),
+    "area_factor": (lambda v: 1 <= v <= 2, "in [1, 2] (Bao Eq. 18)"),
+    "angle": (lambda v: 0 <= v < 1.5707963267948966, "in [0, 90) deg"),
+    "friction": (lambda v: 0 < v < 2, "in (0, 2)"),
+    "any": (lambda v: True, "any value"),
+}
+
+
+@dataclass(frozen=True)
+class Field:
+    """One parameter of a part.
+
+    Attributes
+    ----------
+    kind : str
+        ``"quantity"`` (number or number+unit), ``"quantity_list"``, ``"int"``, ``"bool"``,
+        ``"str"``, ``"str_list"`` or ``"choice"``.
+    dim : str
+        Dimension of a quantity (a key of :data:`clutchocp.units.DIMENSIONS`).
+    check : str
+        Key of :data:`CHECKS` applied to the SI value (each element of a list).
+    required : bool
+        Whether the scene must give it (else ``default`` is used, if any).
+    default : object
+        Default value in SI (``None`` = absent unless given).
+    choices : tuple of str
+        Allowed values of a ``"choice"`` field.
+    doc : str
+        One-line meaning, with units.
+    """
+
+    kind: str = "quantity"
+    dim: str = "1"
+    check: str = "any"
+    required: bool = True
+    default: object = None
+    choices: tuple = ()
+    doc: str = ""
+
+
+def Q(dim, check="positive", doc="", **kw):
+    """A quantity field (number or ``"number unit"``)."""
+    return Field(kind="quantity", dim=dim, check=check, doc=doc, **kw)
+
+
+def QOpt(dim, default, check="nonnegative", doc=""):
+    """An optional quantity field with an SI default."""
+    return Field(kind="quantity", dim=dim, check=check, required=False, default=default, doc=doc)
+
+
+@dataclass(frozen=True)
+class Part:
+    """A table of a scene file: common fields, and variants chosen by ``model``."""
+
+    doc: str
+    fields: dict = dc_field(default_factory=dict)
+    variants: dict = dc_field(default_factory=dict)
+    default_variant: str = ""
+
+    def allowed_fields(self, variant):
+        """Fields allowed in this part for the given variant (``model`` included)."""
+        out = dict(self.fields)
+        if self.variants:
+            out.update(self.variants[variant])
+        return out
+
+
+PARTS = {
+    "scene": Part(
+        "identity of the scene and the paper it comes from",
+        fields={
+            "name": Field(kind="str", doc="short name, used to load the scene"),
+            "title": Field(kind="str", required=False, default="", doc="one-line description"),
+            "source": Field(kind="str", doc="the paper (and table) the values come from"),
+            "kind": Field(kind="choice", choices=("engagement", "hvd", "static"),
+                          doc="what the scene is for"),
+            "analysis": Field(kind="choice", required=False,
+                              choices=("chen2021_pack", "cui2019_mixed", "liao2021_hvc"),
+                              doc="static analysis run by 'clutchocp validate'"),
+            "assumptions": Field(kind="str_list", required=False, default=(),
+                                 doc="values not in the paper, each with its reason"),
+            "default": Field(kind="bool", required=False, default=False,
+                             doc="the default scene of 'clutchocp optimize'"),
+        },
+    ),
+    "plates": Part(
+        "friction-pair geometry",
+        fields={
+            "r_inner": Q("m", doc="inner radius of the friction surface [m]"),
+            "r_outer": Q("m", doc="outer radius of the friction surface [m]"),
+            "n_interfaces": Field(kind="int", check="positive",
+                                  doc="number of lubricated friction interfaces (films)"),
+            "land_fraction": QOpt("1", 1.0, "fraction", "non-grooved share of the area (Cui psi)"),
+            "lining_thickness": QOpt("m", 0.0, doc="friction-lining thickness d [m] (Zhang)"),
+            "lining_permeability": QOpt("m^2", 0.0, doc="lining permeability Phi [m^2] (Zhang)"),
+            "effective_diameter": Field(kind="quantity", dim="m", check="positive", required=False,
+                                        doc="effective friction diameter d [m] (Liao Eq. 10)"),
+        },
+    ),
+    "oil": Part(
+        "lubricant",
+        fields={
+            "viscosity": Q("Pa s", doc="dynamic viscosity [Pa s]"),
+            "density": QOpt("kg/m^3", 870.0, "positive", "density [kg/m^3]"),
+        },
+    ),
+    "film": Part(
+        "squeeze-film options of the averaged Reynolds equation",
+        fields={
+            "flow_factor": Field(kind="choice", choices=("patir_cheng", "none"), required=False,
+                                 default="patir_cheng", doc="pressure flow factor phi_r"),
+            "centrifugal": Field(kind="bool", required=False, default=False,
+                                 doc="include the centrifugal term (Bao Eq. 11)"),
+            "inlet_pressure": QOpt("Pa", 0.0, doc="oil pressure at the inner radius [Pa]"),
+        },
+    ),
+    "roughness": Part(
+        "surface roughness and asperities (give sigma, or sigma_1 and sigma_2)",
+        fields={
+            "sigma": Field(kind="quantity", dim="m", check="nonnegative", required=False,
+                           doc="combined RMS roughness [m]"),
+            "sigma_1": Field(kind="quantity", dim="m", check="nonnegative", required=False,
+                             doc="RMS roughness of the friction plate [m]"),
+            "sigma_2": Field(kind="quantity", dim="m", check="nonnegative", required=False,
+                             doc="RMS roughness of the separator [m]"),
+            "asperity_density": QOpt("1/m^2", None, "positive", "asperity density n_a [1/m^2]"),
+            "asperity_radius": QOpt("m", None, "positive", "asperity tip radius beta [m]"),
+        },
+    ),
+    "contact": Part(
+        "asperity contact law",
+        variants={
+            "none": {},
+            "greenwood_tripp": {
+                "E_equiv": Q("Pa", doc="equivalent elastic modulus E' [Pa]"),
+                "fit": Field(kind="choice", choices=("exact", "patir"), required=False,
+                             default="exact", doc="F_5/2 exact or Bao Eq. 19 fit"),
+                "area_factor": QOpt("1", 1.0, "area_factor", "elastoplastic area factor n0"),
+                "hardness": QOpt("Pa", None, "positive", "hardness H' [Pa]"),
+            },
+            "zhang_gw": {"E_equiv": Q("Pa", doc="equivalent elastic modulus E [Pa]")},
+            "fractal_mb": {
+                "E_equiv": Q("Pa", doc="equivalent elastic modulus E [Pa]"),
+                "fractal_dimension": Q("1", "fractal_dimension", "fractal dimension D"),
+                "fractal_scale": Q("m", doc="fractal scale factor G [m]"),
+                "hardness": Q("Pa", doc="hardness of the softer material [Pa]"),
+                "yield_strength": Q("Pa", doc="yield (compressive) strength [Pa]"),
+            },
+        },
+        default_variant="greenwood_tripp",
+    ),
+    "friction": Part(
+        "asperity friction-coefficient law",
+        fields={
+            "static_coefficient": QOpt("1", None, "friction",
+                                       "static COF for the lock-up capacity (default: law at v = 0)"),
+        },
+        variants={
+            "constant": {"mu": Q("1", "friction", "friction coefficient")},
+            "stribeck": {
+                "mu_static": Q("1", "friction", "COF at zero slip"),
+                "mu_kinetic": Q("1", "friction", "COF at high slip"),
+                "v_stribeck": Q("m/s", doc="Stribeck velocity [m/s]"),
+            },
+            "chen2021": {"temperature_C": Field(kind="quantity", dim="1", check="positive",
+                                                doc="surface temperature [deg C] (Chen Eq. 5)")},
+            "cui2019": {},
+            "table": {
+                "pressure": Field(kind="quantity_list", dim="Pa", check="nonnegative",
+                                  doc="contact pressures [Pa]"),
+                "mu": Field(kind="quantity_list", dim="1", check="friction", doc="COF at each pressure"),
+            },
+        },
+        default_variant="constant",
+    ),
+    "spline": Part(
+        "spline friction of the plates in their carriers (Chen 2021)",
+        fields={
+            "friction_coefficients": Field(kind="quantity_list", dim="1", check="friction",
+                                           doc="spline COF mu_fs (one or more values)"),
+            "pitch_radius_friction": Q("m", doc="spline pitch radius of the friction discs [m]"),
+            "pitch_radius_separator": Q("m", doc="spline pitch radius of the separators [m]"),
+            "pressure_angle_friction": Q("rad", "angle", "spline pressure angle, friction discs"),
+            "pressure_angle_separator": Q("rad", "angle", "spline pressure angle, separators"),
+            "first": Field(kind="choice", choices=("separator", "friction"), required=False,
+                           default="separator", doc="plate type next to the piston"),
+        },
+    ),
+    "groove": Part(
+        "radial grooves (Liao Eq. 2)",
+        fields={
+            "depth": Q("m", "nonnegative", "groove depth h_a [m]"),
+            "angle_ratio": Q("1", doc="non-groove / groove angle theta2/theta1 (K2)"),
+        },
+    ),
+    "hvc": Part(
+        "hydro-viscous clutch film distribution (Liao Eq. 13)",
+        fields={
+            "friction_ratio": Q("1/m^2", "nonnegative", "K3/K1 [1/m^2]"),
+            "first_film": Q("m", doc="thickness of the film next to the piston [m]"),
+        },
+    ),
+    "operating": Part(
+        "operating point of a static analysis",
+        fields={
+            "speed_input": QOpt("rad/s", 0.0, doc="input (friction plate) speed [rad/s]"),
+            "speed_output": QOpt("rad/s", 0.0, doc="output (separator) speed [rad/s]"),
+            "temperature_C": QOpt("1", None, "positive", "oil / surface temperature [deg C]"),
+            "pressures": Field(kind="quantity_list", dim="Pa", check="nonnegative", required=False,
+                               doc="applied pressures [Pa]"),
+        },
+    ),
+    "piston": Part(
+        "piston with return or preload spring and seal friction",
+        fields={
+            "mass": Q("kg", doc="piston mass [kg]"),
+            "area": Q("m^2", doc="hydraulic area [m^2]"),
+            "spring_stiffness": QOpt("N/m", 0.0, doc="stiffness of one spring [N/m]"),
+            "spring_count": Field(kind="int", check="positive", required=False, default=1,
+                                  doc="number of springs"),
+            "spring_preload": QOpt("m", 0.0, doc="initial spring compression [m]"),
+            "travel_to_pack": QOpt("m", 0.0, doc="free travel before the piston meets plate 1 [m]"),
+            "seal_length": QOpt("m", 0.0, doc="seal contact length L [m] (Bao Eq. 16)"),
+            "seal_diameter": QOpt("m", 0.0, doc="seal diameter D [m] (Bao Eq. 16)"),
+            "seal_clearance": QOpt("m", 1.0, "positive", "radial clearance psi [m] (Bao Eq. 16)"),
+        },
+        variants={"pressure_applied": {}, "spring_applied": {}},
+        default_variant="pressure_applied",
+    ),
+    "pack": Part(
+        "plate pack axial dynamics",
+        fields={
+            "initial_gap": Q("m", doc="initial film thickness H0 of every gap [m]"),
+        },
+        variants={
+            "masses": {"plate_masses": Field(kind="quantity_list", dim="kg", check="positive",
+                                             doc="mass of each moving plate, piston side first [kg]")},
+            "massless": {},
+        },
+        default_variant="massless",
+    ),
+    "actuation": Part(
+        "engagement pressure",
+        fields={
+            "pressure": Q("Pa", "nonnegative", "set pressure P_o [Pa]"),
+            "initial_pressure": QOpt("Pa", 0.0, doc="pressure at t = 0 [Pa]"),
+            "t_start": QOpt("s", 0.0, doc="time the command starts [s]"),
+            "area": QOpt("m^2", None, "positive",
+                         "area the pressure acts on when there is no piston [m^2] (default: plate area)"),
+            "max_pressure": QOpt("Pa", None, "positive", "upper pressure limit [Pa]"),
+        },
+        variants={
+            "step": {},
+            "ramp": {"ramp_time": Q("s", doc="time to reach the set pressure [s]")},
+            "first_order_lag": {"time_constant": Q("s", doc="lag t_s [s] (Zhang Eq. 7)")},
+            "valve_lag": {"time_constant": Q("s", doc="valve time constant [s], a state")},
+            "table": {"file": Field(kind="str", doc="CSV file (time s, pressure Pa), relative to the scene")},
+        },
+        default_variant="first_order_lag",
+    ),
+    "driveline": Part(
+        "rotating side",
+        fields={
+            "input": Field(kind="choice", choices=("prescribed_speed", "inertia"),
+                           doc="input side: fixed speed or an inertia"),
+            "input_speed": Q("rad/s", "nonnegative", "initial (or prescribed) input speed [rad/s]"),
+            "output": Field(kind="choice", choices=("inertia", "fixed"), required=False,
+                            default="inertia", doc="output side: an inertia, or held at rest (a brake)"),
+            "input_inertia": QOpt("kg m^2", None, "positive", "input inertia [kg m^2]"),
+            "input_torque": QOpt("N m", 0.0, "any", "torque driving the input [N m]"),
+            "output_inertia": QOpt("kg m^2", None, "positive", "output inertia [kg m^2]"),
+            "output_speed": QOpt("rad/s", 0.0, "nonnegative", "initial output speed [rad/s]"),
+            "shaft_stiffness": QOpt("N m", None, "positive", "output-shaft torsional stiffness [N m/rad]"),
+            "shaft_damping": QOpt("N m s", 0.0, doc="output-shaft torsional damping [N m s/rad]"),
+        },
+    ),
+    "load": Part(
+        "load torque on the output",
+        fields={},
+        variants={
+            "none": {},
+            "constant": {"torque": Q("N m", "nonnegative", "load torque [N m]")},
+            "quadratic": {
+                "rated_torque": Q("N m", doc="torque at the rated speed [N m]"),
+                "rated_speed": Q("rad/s", doc="rated output speed [rad/s]"),
+            },
+            "table": {"file": Field(kind="str", doc="CSV file (speed rad/s, torque N m)")},
+        },
+        default_variant="none",
+    ),
+    "simulation": Part(
+        "integration settings",
+        fields={
+            "t_end": Q("s", doc="end time [s]"),
+            "rtol": QOpt("1", 1e-8, "positive", "relative tolerance"),
+            "atol": QOpt("1", 1e-10, "positive", "absolute tolerance (scaled states)"),
+            "output_points": Field(kind="int", check="positive", required=False, default=2001,
+                                   doc="number of output times"),
+        },
+    ),
+}
+
+# Parts a scene of each kind must declare.
+REQUIRED_PARTS = {
+    "engagement": ("scene", "plates", "oil", "roughness", "contact", "friction", "pack",
+                   "actuation", "driveline", "simulation"),
+    "hvd": ("scene", "plates", "oil"),
+    "static": ("scene", "plates"),
+}

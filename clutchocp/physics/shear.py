@@ -49,7 +49,8 @@ def _phi_f_thick(z):
 
 def _phi_f_far(z):
     """Cui Eq. 6, H > 3 branch as a series in u^2 = 1/z^2 (accurate to 1e-16 for z >= 2)."""
-    u2 = 1.0 / (z * z)
+    u = 1.0 / z
+    u2 = u * u
     acc = 0.0
     for c in reversed(_SERIES):          # Horner in u^2
         acc = (acc + c) * u2
@@ -62,8 +63,9 @@ def shear_factor_phi_f(H, eps=EPS_STAR, smooth=False, width=0.05):
     With z = H/3: for H <= 3, phi_f = (35/32) z {(1 - z^2)^3 ln((z+1)/eps*) + (1/60)[-55 + z(132
     + z(345 + z(-160 + z(-405 + z(60 + 147 z)))))]}; for H > 3, phi_f = (35/32) z {(1 - z^2)^3
     ln((z+1)/(z-1)) + (z/15)[66 + z^2 (30 z^2 - 80)]}. The branches join C2 at H = 3 (value 7/6,
-    slope -8/45 per unit H); for H >= 6 the H > 3 branch is evaluated by its exact series
-    1 + 105 sum u^(2m)/((2m+1)(2m+3)(2m+5)(2m+7)), u = 3/H, so phi_f -> 1 + 1/H^2 as H -> inf.
+    slope -7/36, curvature 7/12 per unit H; not C3). For H >= 6 the H > 3 branch is evaluated
+    by its exact series 1 + 105 sum u^(2m)/((2m+1)(2m+3)(2m+5)(2m+7)), u = 3/H, so
+    phi_f -> 1 + 1/H^2 as H -> inf.
     phi_f(0) = 0 and phi_f = 0 for H < 0 (no fluid film to shear; z is clamped at 0).
 
     Parameters
@@ -137,7 +139,9 @@ def shear_factor_phi_fs(H, sigma_1, sigma_2, smooth=False, width=0.1):
     else:
         Hc = fmin(Hp, H_CUT_FS)                       # finite in the unselected branch
         cut = if_else(Hp <= H_CUT_FS, 1.0, 0.0)
-    Phi_fs = A3 * Hp**ALPHA4 * exp(-ALPHA5 * Hc + ALPHA6 * Hc * Hc)            # Cui Eq. 8
+    # the base of H^a4 is capped at 10 only to avoid overflow for huge H, where cut is 0
+    # (exact) or below exp(-60) (smooth), so the cap changes nothing visible
+    Phi_fs = A3 * fmin(Hp, 10.0)**ALPHA4 * exp(-ALPHA5 * Hc + ALPHA6 * Hc * Hc)   # Cui Eq. 8
     return _variance_ratio_difference(sigma_1, sigma_2) * Phi_fs * cut           # Cui Eq. 7
 
 
@@ -161,7 +165,8 @@ def viscous_torque(w_rel, h, eta, r1, r2, *, sigma_1=0.0, sigma_2=0.0, area_rati
     r1, r2 : float or symbol
         Inner and outer radius [m].
     sigma_1, sigma_2 : float or symbol, keyword
-        RMS roughness of the two surfaces [m]; sigma_1 = sigma_2 = 0 means smooth plates.
+        RMS roughness of the two surfaces [m]; sigma_1 = sigma_2 = 0 (as numbers) means smooth
+        plates; symbols must not both evaluate to 0 (H = h / sigma).
     area_ratio : float or symbol, keyword
         Real contact area ratio A_c / A_n [-] (area not sheared by the oil).
     land_fraction : float or symbol, keyword

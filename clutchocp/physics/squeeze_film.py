@@ -56,6 +56,7 @@ _EXT_B = 0.5 * (_D2 / _PHI0 - _EXT_A**2)                    # -1.04287
 
 def _pc_extension(x):
     """C2 continuation of the fit for x = H - 0.5 <= 0: phi0 exp(a x + b x^2)."""
+    x = fmax(x, -40.0)       # avoids x*x overflow; the value there is exp(-1700) = 0 in doubles
     return _PHI0 * exp(_EXT_A * x + _EXT_B * x * x)
 
 
@@ -108,8 +109,9 @@ def squeeze_geometry(r1, r2):
     """Geometry factor of the annular squeeze film.
 
     G = r2^4 - r1^4 - (r2^2 - r1^2)^2 / ln(r2/r1), the bracket of the load integral
-    (Liao 2021 Eq. 7, Bao 2020 Eq. 12 integrated). G > 0 for 0 < r1 < r2; G -> r2^4 for
-    r1 -> 0 and G ~ (4/3) r1 (r2 - r1)^3 for a narrow annulus (a plane strip squeeze film);
+    (Liao 2021 Eq. 7, Bao 2020 Eq. 12 integrated). G > 0 for 0 < r1 < r2; G -> r2^4 (full disc)
+    only logarithmically as r1 -> 0, G = r2^4 (1 - 1/ln(r2/r1)) + O(r1^2), because p = 0 is imposed
+    at r1; G ~ (4/3) r (r2 - r1)^3 for a narrow annulus (a plane strip squeeze film);
     in the latter limit the subtraction loses about 3 (r1/(r2-r1))^2 ulps.
 
     Parameters
@@ -195,8 +197,9 @@ def film_load(h, dhT_dt, eta, r1, r2, *, phi_r=1.0, permeability=0.0, lining_thi
     - inlet: P0 [...] equals Liao's F1 (Eq. 5);
     - centrifugal: -(pi/4) rho K G / phi_r, K = (3 w1^2 + 3 w2^2 + 4 w1 w2)/10
       = w1^2 - w1 dw + 0.3 dw^2 (dw = w1 - w2). Liao's F2 (Eq. 6) has the same K but the radial
-      factor (pi/6)(r2^4 - r1^4) instead of (pi/4) G: it does not satisfy p(r1) = p(r2) = 0 and
-      is 2 (r2^4 - r1^4) / (3 G) times this term (-> 2/3 for r1 -> 0, 16.5 for r1/r2 = 0.7).
+      factor (pi/6)(r2^4 - r1^4) instead of (pi/4) G, so it is not the load of the Reynolds
+      solution with p(r1) = p(r2) = 0; it is 2 (r2^4 - r1^4) / (3 G) times this term (-> 2/3 as
+      r1 -> 0, 16.5 for r1/r2 = 0.7). This module follows the Reynolds solution (Bao Eq. 7).
 
     Multiply by (1 - A_c/A_n) to carry only the non-contact area as in Bao Eq. 12.
 

@@ -32,8 +32,18 @@ def tanh(x):
     return ca.tanh(x) if is_symbolic(x) else np.tanh(x)
 
 
+def cos(x):
+    return ca.cos(x) if is_symbolic(x) else np.cos(x)
+
+
 def erf(x):
     return ca.erf(x) if is_symbolic(x) else special.erf(x)
+
+
+def erfc(x):
+    """Complementary error function: scipy's (accurate in the tail) for numbers, ``1 - erf``
+    for CasADi (which has no erfc; tails below ~1e-15 are rounding noise there)."""
+    return 1 - ca.erf(x) if is_symbolic(x) else special.erfc(x)
 
 
 def fabs(x):

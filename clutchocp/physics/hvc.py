@@ -11,7 +11,7 @@ speed everywhere only the groove (hydrodynamic) term F4 differs between films
     1 / g(delta_i) = 1 / g(delta_{i+1}) + (K3/K1) f(delta_j)                  (Liao Eq. 13)
     g(delta) = delta^3 + K2 (delta + h_a)^3,   f(delta) = K2 / delta + 1 / (delta + h_a),
 
-K2 = theta2/theta1 (non-groove / groove angle), h_a the groove depth. Liao's own notes:
+K2 = theta2/theta1 (non-groove / groove angle), h_a the groove depth. Notes on the paper:
 
 * Erratum, Eq. 13: the same film thickness is called delta_i (film load, Eq. 9) and
   sigma_i (friction force, Eq. 11) in one equation; both are the thickness of film i.
@@ -19,26 +19,32 @@ K2 = theta2/theta1 (non-groove / groove angle), h_a the groove depth. Liao's own
   friction force at the leading film (j = i, as Eq. 13 prints), its general line
   F_d(i-1) = F_di + F_mi at the trailing film (j = i + 1). Only the trailing form
   reproduces Liao's Table 3: starting from the first film that Table 3 implies
-  (below), it gives the tabulated modified coefficients alpha_i within ~10 % and the
-  "new formula" torques within ~7 %, while the leading form grows the films much too
+  (below), it gives the tabulated modified coefficients alpha_i within 16 % (per-test
+  median 8 %), the paper's "new formula" torques within 7 % and the bench torques within
+  4 %, while the leading form grows the films much too
   fast (sigma_5/sigma_1 = 2.1 against 1.7 tabulated, up to 12 against 3.3 for K2 = 2.5).
   ``friction_film="trailing"`` is therefore the default; ``"leading"`` is Eq. 13 as printed.
 * Units of K3/K1: it is a force ratio times a length^3 / length, i.e. 1/length^2. In SI
-  (1/m^2) the paper's 0.05-0.15 would change the films by < 1e-6; in 1/um^2 no second film
-  exists. In 1/mm^2 (the unit of the groove depths in Table 1 and 3) the films grow by
+  (1/m^2) the paper's 0.05-0.15 would change the films by < 1e-5, in 1/cm^2 by ~1 %; in
+  1/um^2 the films run away (a second film of tens of metres). In 1/mm^2 (the unit of the groove depths in Table 1 and 3) the films grow by
   15-50 % per film, the pattern of Table 3. So K3/K1 = 0.1 means 0.1 mm^-2 = 1e5 m^-2.
 * First film: Liao does not state it. Table 3 gives, per test, the torque by the original
   formula (Eq. 2 with one film thickness sigma_bar for all n films) and alpha_i = sigma_bar /
   sigma_i; inverting Eq. 2 for sigma_bar and dividing by alpha_1 gives delta_1 = 0.105-0.165 mm
   (median 0.13 mm) over the nine tests (computed in clutchocp.analyses.liao2021).
   Note that Table 3's alpha_i do not satisfy sum(1/alpha_i) = n, as the definition
-  alpha_i = mean(sigma) / sigma_i would require (sum ~ 6.3-7.0 for n = 5): sigma_bar is the
+  alpha_i = mean(sigma) / sigma_i would require (sum 6.3-8.7 for n = 5): sigma_bar is the
   film of the original formula, not the mean of the unequal films.
 
+The original torque formulas, Liao Eq. 2 (and Eq. 1 with h_a = 0) for n equal films, are
+:func:`clutchocp.physics.shear.grooved_viscous_torque`; :func:`revised_torque` is Eq. 14.
+
 The film recursion solves one scalar equation per film by Newton's method. Its residual
-R(x) = 1/g(x) [+ k f(x)] - c is convex and decreasing in x > 0 and positive at the
-previous film, so Newton started there increases monotonically to the root (no overshoot,
-no negative film); a fixed number of steps makes the same code build CasADi expressions.
+R(x) = 1/g(x) [+ k f(x)] - c is decreasing in x > 0, convex for K2 > 0.03 (Liao: 1.5-2.5;
+a non-convergence is caught for numeric input) and positive at the
+previous film, so Newton started there (or at a larger point where R is still >= 0)
+increases monotonically to the root (no overshoot, no negative film); a fixed number of
+steps makes the same code build CasADi expressions.
 """
 
 import numpy as np
@@ -128,7 +134,7 @@ def film_balance_residual(delta_i, delta_next, groove_depth, angle_ratio, k3_ove
 
 
 def film_distribution(first_film, n_films, groove_depth, angle_ratio, k3_over_k1, *,
-                      friction_film="trailing", newton_steps=60, rtol=1e-12):
+                      friction_film="trailing", newton_steps=60, rtol=1e-12, max_film=0.01):
     """Thickness of every film of an HVC pack, from the piston side (Liao Eq. 13).
 
     Parameters
@@ -151,6 +157,10 @@ def film_distribution(first_film, n_films, groove_depth, angle_ratio, k3_over_k1
     rtol : float
         For numeric input: required relative residual; a film that does not converge
         raises ModelError.
+    max_film : float
+        For numeric input: a film thicker than this [m] raises ModelError (the films run
+        away: the static friction is more than the groove load can balance and the pack
+        opens; each film then grows roughly as the cube of the one before).
 
     Returns
     -------
@@ -163,7 +173,7 @@ def film_distribution(first_film, n_films, groove_depth, angle_ratio, k3_over_k1
     ModelError
         If n_films < 1, or (numeric input) the balance has no positive solution — with
         ``friction_film="leading"`` the friction force can exceed the whole film load —
-        or Newton did not converge.
+        a film exceeds ``max_film``, or Newton did not converge.
     """
     _check_choice(friction_film)
     n = int(n_films)
@@ -184,7 +194,14 @@ def film_distribution(first_film, n_films, groove_depth, angle_ratio, k3_over_k1
                     f"film {i + 1}: the static friction force exceeds the film load (Liao Eq. 13 "
                     f"with friction_film='leading' has no solution); reduce hvc.friction_ratio or the first film"
                 )
-        x = prev
+        # Start at the largest of three points where R >= 0 (so Newton stays left of the root):
+        # the previous film, and the roots of the bounds g <= (1 + K2)(x + h_a)^3 and
+        # f >= (1 + K2)/(x + h_a), which are close to the root when films run away.
+        x = B.fmax(prev, (1 / ((1 + k2) * c)) ** (1 / 3) - h_a)
+        if trailing:
+            x = B.fmax(x, kap * (1 + k2) / c - h_a)
+        if not symbolic and np.any(np.asarray(x) > max_film):  # x <= root: stop before overflow
+            raise _runaway(i + 1, max_film)
         for _ in range(newton_steps):
             gx = x**3 + k2 * (x + h_a) ** 3
             dg = 3 * x**2 + 3 * k2 * (x + h_a) ** 2
@@ -195,6 +212,8 @@ def film_distribution(first_film, n_films, groove_depth, angle_ratio, k3_over_k1
                 dr = dr - kap * (k2 / x**2 + 1 / (x + h_a) ** 2)
             x = x - r / dr
         if not symbolic:
+            if np.any(np.asarray(x) > max_film):
+                raise _runaway(i + 1, max_film)
             resid = np.abs(film_balance_residual(prev, x, h_a, k2, kap, friction_film=friction_film))
             if np.any(~np.isfinite(x)) or np.any(resid > rtol * np.asarray(c)):
                 raise ModelError(f"film {i + 1}: Newton did not converge in {newton_steps} steps")
@@ -264,6 +283,13 @@ def revised_torque(w_rel, films, eta, r1, r2, groove_depth, angle_ratio):
     for a in alpha:
         total = total + a * groove_share / (sigma_bar + a * groove_depth) + a * land_share / sigma_bar
     return np.pi * eta * w_rel * (r2**4 - r1**4) / 2 * total  # Liao Eq. 14
+
+
+def _runaway(film, max_film):
+    return ModelError(
+        f"film {film}: the films run away (thicker than {max_film:g} m): the static friction exceeds "
+        f"what the groove load can balance; reduce hvc.friction_ratio or the first film"
+    )
 
 
 def _check_choice(friction_film):

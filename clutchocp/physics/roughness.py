@@ -14,7 +14,7 @@ import casadi as ca
 import numpy as np
 from scipy import integrate, special
 
-from .backend import exp, fmax, fmin, if_else, is_symbolic, log, softplus, sqrt
+from .backend import erfc, exp, fmax, fmin, if_else, is_symbolic, log, softplus, sqrt
 
 __all__ = [
     "combined_sigma",
@@ -35,20 +35,9 @@ _SQRT2 = math.sqrt(2.0)
 _SQRT2PI = math.sqrt(2.0 * math.pi)
 
 
-def _erfc(x):
-    """Complementary error function.
-
-    Numeric: ``scipy.special.erfc`` (accurate in the tail).  Symbolic: ``1 - erf`` (CasADi
-    has no erfc), whose absolute error is ~1e-16, so tails below ~1e-15 are noise there.
-    """
-    if is_symbolic(x):
-        return 1 - ca.erf(x)
-    return special.erfc(x)
-
-
 def _upper_tail(H):
     """1 - Phi(H), computed without cancellation for numeric input."""
-    return 0.5 * _erfc(H / _SQRT2)
+    return 0.5 * erfc(H / _SQRT2)
 
 
 def combined_sigma(sigma_1, sigma_2):
@@ -74,7 +63,7 @@ def normal_pdf(H):
 
 def normal_cdf(H):
     """Standard normal distribution ``Phi(H) = erfc(-H/sqrt2) / 2`` [-], H [-]."""
-    return 0.5 * _erfc(-H / _SQRT2)
+    return 0.5 * erfc(-H / _SQRT2)
 
 
 def F0(H):

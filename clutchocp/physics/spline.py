@@ -56,16 +56,7 @@ def attenuation_coefficient(mu, mu_spline, r1, r2, pitch_radius, pressure_angle)
     """
     # Chen Eq. 8
     return (2 * mu * mu_spline * (r2**3 - r1**3)
-            / (3 * pitch_radius * (r2**2 - r1**2) * _cos(pressure_angle)))
-
-
-def _cos(angle):
-    """cos of a float, array or CasADi expression."""
-    if B.is_symbolic(angle):
-        import casadi as ca
-
-        return ca.cos(angle)
-    return np.cos(angle)
+            / (3 * pitch_radius * (r2**2 - r1**2) * B.cos(pressure_angle)))
 
 
 def interface_pressures(p0, zeta_first, zeta_second, n_interfaces):
@@ -127,10 +118,12 @@ def pack_torque(pressures, mu, r1, r2):
     ----------
     pressures : sequence of float/array/CasADi
         Interface pressures p_k [Pa], e.g. from :func:`interface_pressures`.
-    mu : float, CasADi scalar, list/tuple/1-d array, or callable
-        Interface friction coefficient [-]: one value for all interfaces; a list, tuple
-        or numpy array (first axis) with one value per interface; or a function
-        mu(p [Pa]) evaluated at each interface pressure (Chen's mu(p_i) in Eq. 10).
+    mu : float, numpy array, CasADi, list/tuple, or callable
+        Interface friction coefficient [-]. A float, array or CasADi value applies to
+        every interface (an array broadcasts against each interface pressure, e.g. one
+        COF per applied pressure); a list or tuple gives one value per interface; a
+        function mu(p [Pa]) is evaluated at each interface pressure (Chen's mu(p_i),
+        Eq. 10).
     r1, r2 : float
         Inner and outer radius of the friction surface [m].
 
@@ -141,7 +134,7 @@ def pack_torque(pressures, mu, r1, r2):
     pressures = list(pressures)
     if callable(mu):
         mus = [mu(p) for p in pressures]
-    elif isinstance(mu, (list, tuple)) or (isinstance(mu, np.ndarray) and mu.ndim >= 1):
+    elif isinstance(mu, (list, tuple)):
         mus = list(mu)
         if len(mus) != len(pressures):
             raise ModelError(f"mu has {len(mus)} values for {len(pressures)} interfaces")

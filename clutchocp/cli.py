@@ -42,6 +42,20 @@ def _cmd_validate(args):
     return 0
 
 
+def _cmd_simulate(args):
+    from .engagement.report import format_summary, write_engagement
+    from .engagement.run import simulate_engagement
+    from .scene import load_scene, parse_override
+
+    overrides = dict(parse_override(text) for text in args.set)
+    scene = load_scene(args.scene, overrides=overrides)
+    run = simulate_engagement(scene, rtol=args.rtol, atol=args.atol, method=args.method)
+    print(format_summary(run.summary))
+    files = write_engagement(run, args.out)
+    print(f"wrote {len(files)} files to {args.out}: {', '.join(f.name for f in files)}")
+    return 0
+
+
 def build_parser():
     """The argument parser of the ``clutchocp`` command."""
     parser = argparse.ArgumentParser(
@@ -55,6 +69,16 @@ def build_parser():
     p = sub.add_parser("validate", help="static analyses against the seed papers' tables (Chen, Cui, Liao)")
     p.add_argument("--out", default="out/validate", help="output folder (default: out/validate)")
     p.set_defaults(run=_cmd_validate)
+    p = sub.add_parser("simulate", help="simulate an engagement scene through impact and lock-up (IDAS)")
+    p.add_argument("scene", help="scene name (see 'clutchocp scenes') or TOML file")
+    p.add_argument("--out", default="out/simulate", help="output folder (default: out/simulate)")
+    p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
+                   help="override a scene value, e.g. --set oil.viscosity='0.04 Pa s' (repeatable)")
+    p.add_argument("--rtol", type=float, default=None, help="relative tolerance (default: the scene's)")
+    p.add_argument("--atol", type=float, default=None, help="absolute tolerance on scaled states")
+    p.add_argument("--method", default="idas", choices=("idas", "Radau", "BDF", "LSODA"),
+                   help="integrator (default: idas)")
+    p.set_defaults(run=_cmd_simulate)
     return parser
 
 

@@ -264,7 +264,7 @@ class Scene:
         return self._values.get(part, {}).get(key, default)
 
     def with_overrides(self, overrides):
-        """A new scene with ``{"part.key": value}`` replaced (values as in a scene file)."""
+        """A new scene with ``{"part.key": value}`` replaced (values as in a scene file; None removes the key)."""
         raw = {part: dict(table) if isinstance(table, dict) else table for part, table in self.raw.items()}
         for name, value in overrides.items():
             part, dot, key = name.partition(".")
@@ -272,7 +272,10 @@ class Scene:
                 raise UnknownKeyError(f"{name}: an override is written part.key=value (e.g. oil.viscosity=0.04)")
             if part not in PARTS:
                 raise UnknownKeyError(f"{name}: unknown part '{part}'{_suggest(part, PARTS)}")
-            raw.setdefault(part, {})[key] = value
+            if value is None:
+                raw.get(part, {}).pop(key, None)
+            else:
+                raw.setdefault(part, {})[key] = value
         return Scene(raw, self.path)
 
     def __repr__(self):

@@ -1,0 +1,153 @@
+"""The lubricated interfaces of a pack: squeeze-film load, asperity contact and torque per film.
+
+Every film of a scene has the same plates, oil and roughness, so one ``FilmLaw`` serves all of
+them; it publishes, for a film of thickness h, the load W = K (-dh/dt) + S carried by the film
+(fluid + asperities) and the torque it transmits at a relative speed w_rel.
+"""
+
+import math
+
+import casadi as ca
+import numpy as np
+
+from ..errors import ModelError
+from ..physics import contact, friction, roughness, shear, squeeze_film
+from ..physics.backend import fmin
+
+# Chen 2021 Eq. 5 is singular below 25 kPa and fitted for 0.2-2 MPa; Cui Eq. 18 is fitted for
+# 0.1-1 MPa. Outside, the pressure fed to the law is clamped to the fitted range.
+_CHEN_P_RANGE = (0.2e6, 2.0e6)
+_CUI_P_RANGE = (0.1e6, 1.0e6)
+
+
+class FilmLaw:
+    """Load and torque of one film between a friction plate and a separator (SI units).
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+        An engagement scene (plates, oil, film, roughness, contact, friction parts).
+    smooth : bool
+        Use the smooth forms of the switching laws (for optimisation).
+    """
+
+    def __init__(self, scene, smooth=False):
+        self.smooth = smooth
+        self.r1 = scene.value("plates.r_inner")
+        self.r2 = scene.value("plates.r_outer")
+        self.area = math.pi * (self.r2**2 - self.r1**2)
+        self.r_eff = contact.effective_radius(self.r1, self.r2, rule="bao")  # Bao Eq. 25-26
+        self.eta = scene.value("oil.viscosity")
+        self.rho = scene.value("oil.density")
+        self.land_fraction = scene.value("plates.land_fraction")
+        self.permeability = scene.value("plates.lining_permeability")
+        self.lining_thickness = scene.value("plates.lining_thickness")
+        self.flow_factor = scene.get("film.flow_factor", "patir_cheng")
+        self.centrifugal = scene.get("film.centrifugal", False)
+        self.inlet_pressure = scene.get("film.inlet_pressure", 0.0)
+        self.sigma = scene.value("roughness.sigma")
+        # With only the combined roughness known, both surfaces are taken equally rough, which
+        # makes the Patir-Cheng shear factor phi_fs (Cui Eq. 7, V_r1 - V_r2) vanish.
+        self.sigma_1 = scene.get("roughness.sigma_1", self.sigma / math.sqrt(2))
+        self.sigma_2 = scene.get("roughness.sigma_2", self.sigma / math.sqrt(2))
+        self.n_a = scene.get("roughness.asperity_density")
+        self.beta = scene.get("roughness.asperity_radius")
+        self.contact_model = scene.variant("contact")
+        if self.contact_model == "fractal_mb":
+            raise ModelError("contact.model = 'fractal_mb' is for static analyses; an engagement needs "
+                             "greenwood_tripp, zhang_gw or none")
+        self.E = scene.get("contact.E_equiv")
+        self.fit = scene.get("contact.fit", "exact")
+        self.n0 = scene.get("contact.area_factor", 1.0)
+        self.friction_model = scene.variant("friction")
+        self.scene = scene
+        self.mu_static = scene.get("friction.static_coefficient")
+        if self.mu_static is None:
+            self.mu_static = float(self.mu(0.0, 0.5e6))
+
+    # -- asperities ---------------------------------------------------------------------------
+    def area_ratio(self, h):
+        """Real contact area ratio A_c/A_n [-] (0 without contact), at most 0.99.
+
+        The Greenwood-Tripp and Greenwood-Williamson ratios are not bounded by 1 (with Bao's
+        data the GT ratio passes 1 near H = 0); the cap keeps 1 % of the area for the oil.
+        """
+        if self.contact_model == "none":
+            return 0.0
+        H = h / self.sigma
+        if self.contact_model == "greenwood_tripp":
+            ratio = contact.greenwood_tripp_area_ratio(H, self.n_a, self.beta, self.sigma, n0=self.n0)
+        else:
+            ratio = contact.zhang_area_ratio(H, self.n_a, self.beta, self.sigma)
+        return fmin(ratio, 0.99)
+
+    def contact_force(self, h):
+        """Asperity load over the nominal area [N]."""
+        if self.contact_model == "none":
+            return 0.0
+        H = h / self.sigma
+        if self.contact_model == "greenwood_tripp":
+            # Greenwood-Tripp: nominal asperity pressure K' E' F_5/2(H). Bao Eq. 20 multiplies it once
+            # more by the area ratio C; that double-counts the contact area and is not followed.
+            p_c = contact.greenwood_tripp_pressure(H, self.E, self.n_a, self.beta, self.sigma,
+                                                   fit=self.fit, smooth=self.smooth)
+            return p_c * self.area
+        # Zhang Eq. 6 and 8: pressure E*delta on the real area delta*A_n.
+        delta = contact.zhang_area_ratio(H, self.n_a, self.beta, self.sigma)
+        return delta * contact.zhang_contact_pressure(H, self.E, self.n_a, self.beta, self.sigma) * self.area
+
+    # -- axial load ---------------------------------------------------------------------------
+    def load_coefficients(self, h, w_in, w_out):
+        """(K, S) with film load W = K (-dh/dt) + S [N s/m, N], fluid on the non-contact area + asperities."""
+        phi_r = 1.0
+        if self.flow_factor == "patir_cheng" and self.sigma > 0:
+            phi_r = squeeze_film.pressure_flow_factor(h / self.sigma, smooth=self.smooth)
+        kw = dict(phi_r=phi_r, permeability=self.permeability, lining_thickness=self.lining_thickness,
+                  inlet_pressure=self.inlet_pressure)
+        if self.centrifugal:
+            kw.update(rho=self.rho, w1=w_in, w2=w_out)
+        static = squeeze_film.film_load(h, 0.0, self.eta, self.r1, self.r2, **kw)
+        # The load is linear in dh_T/dt; dh_T/dt = Phi(H) dh/dt (Bao Eq. 10).
+        per_rate = squeeze_film.film_load(h, -1.0, self.eta, self.r1, self.r2, **kw) - static
+        gap_rate = roughness.average_gap_derivative(h, self.sigma) if self.sigma > 0 else 1.0
+        fluid_share = 1.0 - self.area_ratio(h)          # Bao Eq. 12, Zhang Eq. 8: fluid on A_n - A_c
+        return fluid_share * per_rate * gap_rate, fluid_share * static + self.contact_force(h)
+
+    # -- torque -------------------------------------------------------------------------------
+    def mu(self, v, p):
+        """Asperity friction coefficient at slip speed v [m/s] and nominal contact pressure p [Pa]."""
+        model, s = self.friction_model, self.scene
+        if model == "constant":
+            return s.value("friction.mu")
+        if model == "stribeck":
+            return friction.mu_stribeck(v, s.value("friction.mu_static"), s.value("friction.mu_kinetic"),
+                                        s.value("friction.v_stribeck"), smooth=self.smooth)
+        if model == "chen2021":
+            return friction.mu_chen2021(v, _clamp(p, *_CHEN_P_RANGE), s.value("friction.temperature_C"),
+                                        smooth=self.smooth)
+        if model == "cui2019":
+            return friction.mu_cui2019(_clamp(p, *_CUI_P_RANGE))
+        pressures, mus = s.value("friction.pressure"), s.value("friction.mu")
+        table = ca.interpolant("mu_table", "linear", [pressures], mus)
+        return table(_clamp(p, pressures[0], pressures[-1]))
+
+    def viscous_torque(self, h, w_rel):
+        """Viscous shear torque of the film [N m], same sign as w_rel (Cui Eq. 9)."""
+        return shear.viscous_torque(w_rel, h, self.eta, self.r1, self.r2, sigma_1=self.sigma_1,
+                                    sigma_2=self.sigma_2, area_ratio=self.area_ratio(h),
+                                    land_fraction=self.land_fraction, smooth=self.smooth)
+
+    def contact_torque(self, h, w_rel, direction):
+        """Asperity friction torque [N m] while slipping in ``direction`` (+1 or -1) (Bao Eq. 25)."""
+        F_c = self.contact_force(h)
+        return direction * self.mu(w_rel * self.r_eff, F_c / self.area) * F_c * self.r_eff
+
+    def static_capacity(self, h):
+        """Largest torque the film holds without slipping [N m]."""
+        return self.mu_static * self.contact_force(h) * self.r_eff
+
+
+def _clamp(x, lo, hi):
+    if isinstance(x, (ca.SX, ca.MX, ca.DM)):
+        return ca.fmin(ca.fmax(x, lo), hi)
+    return np.clip(x, lo, hi)

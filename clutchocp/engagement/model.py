@@ -1,0 +1,411 @@
+"""Assemble the engagement DAE of a scene in CasADi, mode by mode.
+
+The state vector is the same in every mode (so a mode switch is a reset of values, not of
+shape); a part that the scene does not declare adds no state:
+
+    [x0, v0]          piston position and velocity            (scene has a piston)
+    h_1 .. h_n        film thicknesses, scaled by sigma        (always)
+    v_1 .. v_n        plate velocities                         (pack.model = "masses")
+    p_valve           valve output pressure                    (actuation.model = "valve_lag")
+    w_in              input speed                              (driveline.input = "inertia")
+    w_out             output speed                             (driveline.output = "inertia")
+    E_*               energy accumulators for the balance check (always)
+
+Modes are (axial phase) x (rotation): axial phase "approach" (piston travelling freely, plates at
+rest; only with a piston and free travel) or "pressing"; rotation "slip_forward" (w_in > w_out),
+"slip_reverse" or "locked"; a mode is named "<axial>_<rotation>". Events move between them: impact (Bao Eq. 22), lock-up and unlock.
+"""
+
+import math
+
+import casadi as ca
+import numpy as np
+
+from ..errors import ModelError
+from ..simulation.model import Event, HybridModel, Mode
+from .actuation import Actuation
+from .films import FilmLaw
+
+ENERGY_TERMS = ("E_source", "E_hydraulic", "E_load", "E_slip", "E_film", "E_contact", "E_seal", "E_spline",
+                "E_impact")
+ROTATIONS = ("slip_forward", "slip_reverse", "locked")
+
+
+class EngagementModel:
+    """The hybrid engagement model of a scene.
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+        An engagement scene.
+    smooth : bool
+        Smooth forms of the switching laws (for the optimal-control problem).
+    """
+
+    def __init__(self, scene, smooth=False):
+        if scene.kind != "engagement":
+            raise ModelError(f"scene '{scene.name}' is a {scene.kind} scene; an engagement needs kind = 'engagement'")
+        if scene.get("driveline.shaft_stiffness") is not None:
+            raise ModelError("driveline.shaft_stiffness: a compliant output shaft is not supported by the "
+                             "engagement model yet; remove the key to treat the shaft as rigid")
+        self.scene = scene
+        self.film = FilmLaw(scene, smooth=smooth)
+        self.actuation = Actuation(scene)
+        self.n = scene.value("plates.n_interfaces")
+        self.H0 = scene.value("pack.initial_gap")
+        self.sigma = self.film.sigma if self.film.sigma > 0 else self.H0 / 10
+        self.has_piston = scene.has("piston")
+        self.masses = scene.variant("pack") == "masses"
+        self.plate_masses = np.asarray(scene.get("pack.plate_masses", np.zeros(self.n)), dtype=float)
+        if self.masses and scene.has("spline"):
+            raise ModelError("spline: spline friction is modelled for the massless pack (pack.model = 'massless')")
+        self.input_inertia = scene.value("driveline.input") == "inertia"
+        self.output_inertia = scene.value("driveline.output") == "inertia"
+        self.travel = scene.get("piston.travel_to_pack", 0.0) if self.has_piston else 0.0
+        self.t = ca.SX.sym("t")
+        self._build_states()
+        self.modes = {}
+        self.axial_phases = ("approach", "pressing") if self.travel > 0 else ("pressing",)
+        for axial in self.axial_phases:
+            for rotation in ROTATIONS:
+                mode = self._build_mode(axial, rotation)
+                self.modes[mode.name] = mode
+        self.hybrid = HybridModel(list(self.modes.values()), t=self.t)
+
+    # -- states -------------------------------------------------------------------------------
+    def _build_states(self):
+        names, nominal, initial = [], [], []
+
+        def add(name, scale, value):
+            names.append(name)
+            nominal.append(scale)
+            initial.append(value)
+
+        s = self.scene
+        v_scale = self.H0 / max(s.value("simulation.t_end"), 1e-6)
+        if self.has_piston:
+            add("x0", max(self.travel, self.H0), 0.0)
+            add("v0", v_scale, 0.0)
+        for i in range(self.n):
+            add(f"h_{i + 1}", self.sigma, self.H0)
+        if self.masses:
+            for i in range(self.n):
+                add(f"v_{i + 1}", v_scale, 0.0)
+        if self.actuation.has_state:
+            add("p_valve", max(s.value("actuation.pressure"), 1e5), s.value("actuation.initial_pressure"))
+        w_scale = max(s.value("driveline.input_speed"), s.value("driveline.output_speed"), 1.0)
+        if self.input_inertia:
+            add("w_in", w_scale, s.value("driveline.input_speed"))
+        if self.output_inertia:
+            add("w_out", w_scale, s.value("driveline.output_speed"))
+        for name in ENERGY_TERMS:
+            add(name, 1.0, 0.0)
+        self.state_names = tuple(names)
+        self.nominal = np.array(nominal, dtype=float)
+        self.initial_state = np.array(initial, dtype=float)
+        self.x = ca.vertcat(*[ca.SX.sym(name) for name in names])
+        self.index = {name: i for i, name in enumerate(names)}
+
+    def state(self, name):
+        """The CasADi symbol of a named state (unscaled, SI)."""
+        return self.x[self.index[name]]
+
+    @property
+    def n_states(self):
+        """Number of physical states (energy accumulators excluded)."""
+        return len(self.state_names) - len(ENERGY_TERMS)
+
+    # -- parts --------------------------------------------------------------------------------
+    def speeds(self):
+        """(w_in, w_out): states, or the prescribed/fixed values."""
+        s = self.scene
+        w_in = self.state("w_in") if self.input_inertia else s.value("driveline.input_speed")
+        w_out = self.state("w_out") if self.output_inertia else 0.0
+        return w_in, w_out
+
+    def load_torque(self, w_out):
+        """Load torque on the output [N m] (opposes forward rotation)."""
+        model = self.scene.variant("load")
+        if model in ("", "none"):
+            return 0.0
+        if model == "constant":
+            return self.scene.value("load.torque")
+        if model == "quadratic":
+            k = self.scene.value("load.rated_torque") / self.scene.value("load.rated_speed") ** 2
+            return k * w_out * ca.fabs(w_out)
+        raise ModelError("load.model = 'table' is not supported by the engagement model yet")
+
+    def pressure(self):
+        p_state = self.state("p_valve") if self.actuation.has_state else None
+        return self.actuation.pressure(self.t, p_state)
+
+    def piston_position(self, axial):
+        """Piston travel [m]: the state x0 while approaching; once it presses the pack, the free
+        travel plus the closure of the films (x0 = travel + sum (H0 - h_i), Bao Eq. 13), so the
+        integrated x0 is a record, not a second (drifting) copy of the pack geometry."""
+        if axial == "approach":
+            return self.state("x0")
+        return self.travel + sum(self.H0 - self.state(f"h_{i + 1}") for i in range(self.n))
+
+    def drive_force(self, p, x0):
+        """Net axial force on the piston from oil pressure and springs [N] (before pack and seal)."""
+        s = self.scene
+        k = s.value("piston.spring_stiffness") * s.value("piston.spring_count")
+        area = s.value("piston.area")
+        if s.variant("piston") == "spring_applied":
+            return k * (s.value("piston.spring_preload") - x0) - p * area   # Bao Eq. 21
+        return p * area - k * (s.value("piston.spring_preload") + x0)
+
+    def spring_energy(self, x0):
+        s = self.scene
+        k = s.value("piston.spring_stiffness") * s.value("piston.spring_count")
+        if s.variant("piston") == "spring_applied":
+            return 0.5 * k * (s.value("piston.spring_preload") - x0) ** 2
+        return 0.5 * k * (s.value("piston.spring_preload") + x0) ** 2
+
+    def seal_coefficient(self):
+        """Viscous seal friction coefficient eta L pi D / psi [N s/m] (Bao Eq. 16)."""
+        s = self.scene
+        return (self.film.eta * s.value("piston.seal_length") * math.pi * s.value("piston.seal_diameter")
+                / s.value("piston.seal_clearance"))
+
+    def _spline_deductions(self, torques):
+        """Cumulative spline-friction forces d_k taken from the pack force before film k [N].
+
+        A plate carrying torque T in its spline feels an axial friction mu_s T / (R_p cos alpha)
+        against its motion (Chen 2021 Eq. 1-4); the first plate has one friction face, the others two.
+        """
+        s = self.scene
+        if not s.has("spline"):
+            return [0.0] * self.n
+        mu_s = float(s.value("spline.friction_coefficients")[0])
+        kinds = ("separator", "friction") if s.value("spline.first") == "separator" else ("friction", "separator")
+        radius = {k: s.value(f"spline.pitch_radius_{k}") for k in kinds}
+        angle = {k: s.value(f"spline.pressure_angle_{k}") for k in kinds}
+        coeff = [mu_s / (radius[kinds[i % 2]] * math.cos(angle[kinds[i % 2]])) for i in range(self.n)]
+        deductions = [coeff[0] * ca.fabs(torques[0])]
+        for k in range(1, self.n):
+            deductions.append(deductions[-1] + coeff[k] * (ca.fabs(torques[k - 1]) + ca.fabs(torques[k])))
+        return deductions
+
+    # -- one mode -----------------------------------------------------------------------------
+    def _build_mode(self, axial, rotation):
+        s, film, n = self.scene, self.film, self.n
+        rate = {name: 0.0 for name in self.state_names}
+        out = {}
+        p = self.pressure()
+        w_in, w_out = self.speeds()
+        w_rel = w_in - w_out
+        h = [self.state(f"h_{i + 1}") for i in range(n)]
+        K, S = zip(*(film.load_coefficients(hi, w_in, w_out) for hi in h))
+        direction = {"slip_forward": 1.0, "slip_reverse": -1.0, "locked": 0.0}[rotation]
+        T_visc = [film.viscous_torque(hi, w_rel) for hi in h]
+        T_cont = [film.contact_torque(hi, w_rel, direction) for hi in h]
+        T_film = [tv + tc for tv, tc in zip(T_visc, T_cont)]
+        capacity = sum(film.static_capacity(hi) for hi in h)
+        seal_power = 0.0
+        hydraulic_power = 0.0
+        spline_power = 0.0
+
+        # Axial dynamics -------------------------------------------------------------------
+        dh = [0.0] * n
+        if self.has_piston:
+            v0 = self.state("v0")
+            c_seal = self.seal_coefficient()
+            x0 = self.piston_position(axial)
+            F_drive = self.drive_force(p, x0)
+            rate["x0"] = v0
+            seal_power = c_seal * v0**2
+            sign = -1.0 if s.variant("piston") == "spring_applied" else 1.0
+            hydraulic_power = sign * p * s.value("piston.area") * v0
+        if axial == "approach":
+            rate["v0"] = (F_drive - c_seal * v0) / s.value("piston.mass")
+            face_force = 0.0
+        elif self.masses:
+            v = [self.state(f"v_{i + 1}") for i in range(n)]
+            if self.has_piston:
+                v[0] = v0                       # plate 1 moves with the piston (v_1 is its copy)
+            v_next = v[1:] + [0.0]
+            dh = [vn - vi for vi, vn in zip(v, v_next)]                      # Bao Eq. 13
+            W = [Ki * (-dhi) + Si for Ki, dhi, Si in zip(K, dh, S)]
+            if self.has_piston:
+                m_front = s.value("piston.mass") + self.plate_masses[0]     # moving together, Bao Eq. 23
+                front = F_drive - c_seal * v0 - W[0]
+                rate["v0"] = front / m_front
+                rate["v_1"] = rate["v0"]
+                face_force = 0.0
+            else:
+                face_force = p * self._pack_area()
+                rate["v_1"] = (face_force - W[0]) / self.plate_masses[0]
+                hydraulic_power = face_force * v[0]
+            for i in range(1, n):
+                rate[f"v_{i + 1}"] = (W[i - 1] - W[i]) / self.plate_masses[i]   # Bao Eq. 23
+        else:
+            d = self._spline_deductions(T_film)
+            if self.has_piston:
+                # Massless plates: the piston speed fixes the sum of film rates, which sets the
+                # force on the pack face: v0 = sum (F_face - d_k - S_k) / K_k.
+                face_force = (v0 + sum((dk + Sk) / Kk for dk, Sk, Kk in zip(d, S, K))) / sum(1 / Kk for Kk in K)
+                rate["v0"] = (F_drive - c_seal * v0 - face_force) / s.value("piston.mass")
+            else:
+                face_force = p * self._pack_area()
+            force = [face_force - dk for dk in d]
+            dh = [-(Fk - Sk) / Kk for Fk, Sk, Kk in zip(force, S, K)]
+            # Work of the face force not passed on to the films is lost in the splines.
+            spline_power = sum((face_force - Fk) * (-dhi) for Fk, dhi in zip(force, dh))
+            if not self.has_piston:
+                hydraulic_power = face_force * sum(-dhi for dhi in dh)
+        for i in range(n):
+            rate[f"h_{i + 1}"] = dh[i]
+        if self.actuation.has_state:
+            rate["p_valve"] = self.actuation.state_rate(self.t, self.state("p_valve"))
+
+        # Rotation -------------------------------------------------------------------------
+        T_in = s.value("driveline.input_torque") if self.input_inertia else 0.0
+        T_load = self.load_torque(w_out) if self.output_inertia else 0.0
+        I_in = s.get("driveline.input_inertia")
+        I_out = s.get("driveline.output_inertia")
+        if rotation == "locked":
+            if self.input_inertia and self.output_inertia:
+                w_dot = (T_in - T_load) / (I_in + I_out)
+                T_clutch = T_load + I_out * w_dot          # torque the locked clutch carries
+            elif self.input_inertia:                       # output held: input stays at rest
+                w_dot, T_clutch = 0.0, T_in
+            else:                                          # prescribed input speed
+                w_dot, T_clutch = 0.0, T_load
+            a_in = a_out = w_dot
+        else:
+            T_clutch = sum(T_film)
+            a_in = (T_in - T_clutch) / I_in if self.input_inertia else 0.0
+            a_out = (T_clutch - T_load) / I_out if self.output_inertia else 0.0
+        if self.input_inertia:
+            rate["w_in"] = a_in
+        if self.output_inertia:
+            rate["w_out"] = a_out
+
+        # Energy accumulators (work in = kinetic + stored + dissipated) --------------------------
+        source_power = T_in * w_in if self.input_inertia else T_clutch * w_in
+        film_fluid_power = sum((Ki * (-dhi) + Si - film.contact_force(hi)) * (-dhi)
+                               for Ki, Si, dhi, hi in zip(K, S, dh, h))
+        contact_power = sum(film.contact_force(hi) * (-dhi) for hi, dhi in zip(h, dh))
+        rate["E_source"] = source_power
+        rate["E_hydraulic"] = hydraulic_power
+        rate["E_load"] = T_load * w_out
+        rate["E_slip"] = T_clutch * w_rel if rotation != "locked" else 0.0
+        rate["E_film"] = film_fluid_power
+        rate["E_contact"] = contact_power
+        rate["E_seal"] = seal_power
+        rate["E_spline"] = spline_power
+        rate["E_impact"] = 0.0
+        ode = ca.vertcat(*[rate[name] for name in self.state_names])
+
+        # Outputs ------------------------------------------------------------------------------
+        a_out_expr = ca.SX(a_out) if not isinstance(a_out, ca.SX) else a_out
+        jerk = ca.jtimes(a_out_expr, self.x, ode) + ca.jacobian(a_out_expr, self.t)
+        out["pressure_Pa"] = p
+        for i in range(n):
+            out[f"h_{i + 1}_m"] = h[i]
+        out.update(self._positions(h))
+        out["w_in_rad_s"] = w_in
+        out["w_out_rad_s"] = w_out
+        out["viscous_torque_Nm"] = sum(T_visc) if rotation != "locked" else 0.0
+        out["contact_torque_Nm"] = sum(T_cont) if rotation != "locked" else T_clutch
+        out["total_torque_Nm"] = T_clutch
+        out["static_capacity_Nm"] = capacity
+        out["contact_force_N"] = sum(film.contact_force(hi) for hi in h) / n
+        out["pack_force_N"] = face_force
+        out["output_acceleration_rad_s2"] = a_out
+        out["output_jerk_rad_s3"] = jerk
+        out["dissipated_power_W"] = rate["E_slip"] + film_fluid_power + seal_power + spline_power
+        out["kinetic_energy_J"] = self._kinetic_energy()
+        out["spring_energy_J"] = self.spring_energy(x0) if self.has_piston else 0.0
+
+        events = self._events(axial, rotation, direction, w_rel, capacity)
+        x_dict = {name: self.state(name) for name in self.state_names}
+        return Mode(f"{axial}_{rotation}", x_dict, [rate[name] for name in self.state_names],
+                    outputs=out, events=events, x_nominal=dict(zip(self.state_names, self.nominal)))
+
+    def locked_torque(self):
+        """Torque the clutch must carry to keep both sides locked [N m], from the current state."""
+        s = self.scene
+        w_in, w_out = self.speeds()
+        T_in = s.value("driveline.input_torque") if self.input_inertia else 0.0
+        if self.input_inertia and self.output_inertia:
+            T_load = self.load_torque(w_out)
+            I_in, I_out = s.value("driveline.input_inertia"), s.value("driveline.output_inertia")
+            return T_load + I_out * (T_in - T_load) / (I_in + I_out)
+        if self.input_inertia:
+            return T_in
+        return self.load_torque(w_out)
+
+    def _events(self, axial, rotation, direction, w_rel, capacity):
+        """Impact, lock-up and unlock events leaving the mode ``axial/rotation``."""
+        events = []
+        torque_scale = max(abs(self.scene.get("driveline.input_torque", 0.0)), 10.0)
+        if axial == "approach":
+            reset = None
+            if self.masses:
+                m0, m1 = self.scene.value("piston.mass"), self.plate_masses[0]
+                v0 = self.state("v0")
+                v_after = m0 * v0 / (m0 + m1)                                 # Bao Eq. 22
+                loss = 0.5 * m0 * v0**2 - 0.5 * (m0 + m1) * v_after**2
+                reset = {"v0": v_after, "v_1": v_after, "E_impact": self.state("E_impact") + loss}
+            events.append(Event("impact", self.travel - self.state("x0"), f"pressing_{rotation}",
+                                direction=-1, reset=reset, scale=max(self.travel, self.H0)))
+        needed = self.locked_torque()
+        margin = capacity - ca.fabs(needed)
+        if rotation == "locked":
+            for sign, target in ((1.0, "slip_forward"), (-1.0, "slip_reverse")):
+                events.append(Event("unlock", margin, f"{axial}_{target}", direction=-1,
+                                    guard=sign * needed, scale=torque_scale))
+        else:
+            w_scale = max(self.scene.value("driveline.input_speed"), 1.0)
+            reverse = "slip_reverse" if rotation == "slip_forward" else "slip_forward"
+            events.append(Event("lockup", direction * w_rel, f"{axial}_locked", direction=-1,
+                                reset=self._lock_reset(), guard=margin, scale=w_scale))
+            events.append(Event("lockup", direction * w_rel, f"{axial}_{reverse}", direction=-1,
+                                guard=-margin, scale=w_scale))
+        return events
+
+    def _lock_reset(self):
+        """Equal speeds at lock-up (they already agree to the event tolerance)."""
+        if self.input_inertia and self.output_inertia:
+            return {"w_out": self.state("w_in")}
+        if self.output_inertia:
+            return {"w_out": ca.SX(self.scene.value("driveline.input_speed"))}
+        return {"w_in": ca.SX(0.0)}
+
+    def _pack_area(self):
+        return self.scene.get("actuation.area") or self.film.area
+
+    def _positions(self, h):
+        """Plate positions x_i from the films: x_n = H0 - h_n, x_i = H0 - h_i + x_{i+1} (Bao Eq. 13)."""
+        x_next, out = 0.0, {}
+        for i in reversed(range(self.n)):
+            x_next = self.H0 - h[i] + x_next
+            out[f"x_{i + 1}_m"] = x_next
+        return out
+
+    def _kinetic_energy(self):
+        s = self.scene
+        w_in, w_out = self.speeds()
+        ke = 0.0
+        if self.input_inertia:
+            ke += 0.5 * s.value("driveline.input_inertia") * w_in**2
+        if self.output_inertia:
+            ke += 0.5 * s.value("driveline.output_inertia") * w_out**2
+        if self.has_piston:
+            ke += 0.5 * s.value("piston.mass") * self.state("v0") ** 2
+        if self.masses:
+            for i in range(self.n):
+                ke += 0.5 * self.plate_masses[i] * self.state(f"v_{i + 1}") ** 2
+        return ke
+
+    # -- mode logic -------------------------------------------------------------------------
+    def initial_mode(self):
+        """The mode at t = 0."""
+        axial = "approach" if self.travel > 0 else "pressing"
+        w_in, w_out = self.scene.value("driveline.input_speed"), self.scene.value("driveline.output_speed")
+        if not self.output_inertia:
+            w_out = 0.0
+        return f"{axial}_{'slip_forward' if w_in >= w_out else 'slip_reverse'}"

@@ -1,0 +1,96 @@
+"""Files of an engagement run: summary.json, timeseries.csv and PNG figures."""
+
+from pathlib import Path
+
+import numpy as np
+
+from ..output import new_figure, save_figure, write_csv, write_summary
+
+
+def write_engagement(run, out_dir):
+    """Write the summary, the time series and the figures of an engagement run.
+
+    Parameters
+    ----------
+    run : clutchocp.engagement.run.EngagementResult
+    out_dir : str or pathlib.Path
+        Created if needed.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    series = run.series()
+    columns = {name: [str(v) for v in values] if name == "mode" else np.asarray(values, dtype=float)
+               for name, values in series.items()}
+    files = [write_summary(out / "summary.json", run.summary), write_csv(out / "timeseries.csv", columns)]
+    files += plot_engagement(run, out)
+    return files
+
+
+def _mark_lock(ax, run):
+    t_lock = run.summary["engagement_time_s"]
+    if t_lock is not None:
+        ax.axvline(t_lock, color="0.5", lw=0.8, ls="--", label="lock-up")
+
+
+def plot_engagement(run, out):
+    """Gaps, speeds, torque components and pressure against time, one PNG each."""
+    res, model, name = run.result, run.model, run.summary["scene"]
+    t = res.t
+    files = []
+
+    fig, (ax,) = new_figure()
+    for i in range(model.n):
+        ax.plot(t, res[f"h_{i + 1}_m"] * 1e6, label=f"film {i + 1}")
+    ax.set(xlabel="time [s]", ylabel="film thickness [um]", title=f"{name}: oil films")
+    ax.set_yscale("log")
+    _mark_lock(ax, run)
+    ax.legend(fontsize=8)
+    files.append(save_figure(fig, out / "gaps.png"))
+
+    fig, (ax,) = new_figure()
+    ax.plot(t, res["w_in_rad_s"], label="input")
+    ax.plot(t, res["w_out_rad_s"], label="output")
+    ax.set(xlabel="time [s]", ylabel="speed [rad/s]", title=f"{name}: speeds")
+    _mark_lock(ax, run)
+    ax.legend(fontsize=8)
+    files.append(save_figure(fig, out / "speeds.png"))
+
+    fig, (ax,) = new_figure()
+    ax.plot(t, res["viscous_torque_Nm"], label="viscous")
+    ax.plot(t, res["contact_torque_Nm"], label="asperity contact")
+    ax.plot(t, res["total_torque_Nm"], "k", lw=1.5, label="total")
+    ax.set(xlabel="time [s]", ylabel="clutch torque [N m]", title=f"{name}: torque components")
+    _mark_lock(ax, run)
+    ax.legend(fontsize=8)
+    files.append(save_figure(fig, out / "torque.png"))
+
+    fig, (ax,) = new_figure()
+    ax.plot(t, res["pressure_Pa"] / 1e6)
+    ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{name}: engagement pressure")
+    _mark_lock(ax, run)
+    files.append(save_figure(fig, out / "pressure.png"))
+    return files
+
+
+def format_summary(summary):
+    """A few lines for the terminal."""
+    def num(key, unit, fmt="{:.4g}"):
+        value = summary[key]
+        return "never" if value is None else f"{fmt.format(value)} {unit}"
+
+    lines = [
+        f"scene {summary['scene']}: {summary['n_states']} states, final mode {summary['final_mode']}",
+        f"  engagement (lock-up) time   {num('engagement_time_s', 's')}",
+        f"  lock-up torque jump         {num('lockup_torque_jump_Nm', 'N m')}",
+        f"  peak torque                 {num('peak_torque_Nm', 'N m')}",
+        f"  peak output jerk            {num('peak_jerk_rad_s3', 'rad/s^3')}",
+        f"  dissipated energy           {num('dissipated_energy_J', 'J')}",
+        f"  energy balance error        {num('energy_balance_rel_error', '(relative)', '{:.2e}')}",
+        f"  wall time                   {num('wall_time_s', 's', '{:.3f}')}",
+    ]
+    return "\n".join(lines)

@@ -1,0 +1,176 @@
+"""CasADi functions of each mode, on scaled variables.
+
+Every function takes ``(xs, zs, pu, t)`` with ``xs = x / x_nominal``, ``zs = z / z_nominal``,
+``pu`` = parameters followed by inputs, in model order. Both integrator paths (IDAS and
+scipy) use exactly these functions, so they integrate the same equations.
+"""
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from clutchocp.errors import ModelError
+
+
+@dataclass(frozen=True)
+class EventSpec:
+    """Compiled description of one event of a mode."""
+
+    index: int          # position in the mode's event list
+    name: str
+    direction: int
+    target: str
+    key: int            # index of the first event with the same function and scale (shared location)
+
+
+def _column(exprs):
+    return ca.vertcat(*exprs) if len(exprs) else ca.SX(0, 1)
+
+
+def _function(name, inputs, outputs, what, mode):
+    try:
+        return ca.Function(name, inputs, outputs)
+    except RuntimeError:
+        free = ca.Function(name, inputs, outputs, {"allow_free": True}).free_sx()
+        raise ModelError(f"mode '{mode}': {what} uses symbols {[str(s) for s in free]} that are neither "
+                         "its states, its algebraic variables, the model parameters, inputs nor time") from None
+
+
+class CompiledMode:
+    """The scaled DAE, events, guards, resets and outputs of one mode as CasADi Functions."""
+
+    def __init__(self, mode, model):
+        self.name = mode.name
+        self.x_names = list(mode.x)
+        self.z_names = list(mode.z)
+        self.output_names = list(mode.outputs)
+        self.x_nominal = mode.x_nominal
+        self.z_nominal = mode.z_nominal
+        self.z_guess_scaled = mode.z_guess / mode.z_nominal if mode.z else np.zeros(0)
+        self.nx, self.nz = len(self.x_names), len(self.z_names)
+
+        self.xs = ca.SX.sym(f"{mode.name}_xs", self.nx)
+        self.zs = ca.SX.sym(f"{mode.name}_zs", self.nz)
+        self.pu = _column(list(model.p.values()) + list(model.u.values()))
+        self.t = model.t
+        args = [self.xs, self.zs, self.pu, self.t]
+        old = _column(list(mode.x.values()) + list(mode.z.values()))
+        new = ca.vertcat(self.xs * ca.DM(mode.x_nominal), self.zs * ca.DM(mode.z_nominal)) \
+            if self.nz else self.xs * ca.DM(mode.x_nominal)
+
+        def scaled(exprs):
+            return ca.substitute(_column(exprs), old, new)
+
+        self.ode_s = scaled(mode.ode) / ca.DM(mode.x_nominal)
+        self.alg_s = scaled(mode.alg) / ca.DM(mode.alg_nominal) if self.nz else ca.SX(0, 1)
+        self.f_ode = _function(f"{self.name}_ode", args, [self.ode_s], "the ode", self.name)
+        self.f_alg = _function(f"{self.name}_alg", args, [self.alg_s], "the algebraic equations", self.name)
+        self.f_outputs = _function(f"{self.name}_outputs", args, [scaled(list(mode.outputs.values()))],
+                                   "an output", self.name)
+
+        # events: scaled functions, guards (>= 0 lets the event fire), shared-location keys
+        self.events = []
+        functions = []
+        for i, ev in enumerate(mode.events):
+            fun = ca.SX(ev.function)
+            key = next((j for j, e in enumerate(mode.events[:i])
+                        if e.scale == ev.scale and ca.is_equal(ca.SX(e.function), fun, 16)), i)
+            self.events.append(EventSpec(i, ev.name, ev.direction, ev.target, key))
+            functions.append(fun / ev.scale)
+        self.f_events = _function(f"{self.name}_events", args, [scaled(functions)], "an event function", self.name)
+        guards = [ca.SX(1.0) if ev.guard is None else ca.SX(ev.guard) for ev in mode.events]
+        self.f_guards = _function(f"{self.name}_guards", args, [scaled(guards)], "an event guard", self.name)
+        self._mode = mode
+
+        # the same DAE on normalised time tau in [0, 1], t = t0 + tau dt (event location)
+        tau, t0, dt = ca.SX.sym("tau"), ca.SX.sym("t0"), ca.SX.sym("dt")
+        at = lambda e: ca.substitute(e, self.t, t0 + tau * dt)
+        self.dae = {"x": self.xs, "z": self.zs, "p": self.pu, "t": self.t, "ode": self.ode_s, "alg": self.alg_s}
+        self.dae_tau = {"x": self.xs, "z": self.zs, "p": ca.vertcat(self.pu, t0, dt), "t": tau,
+                        "ode": dt * at(self.ode_s), "alg": at(self.alg_s)}
+
+        self._rootfinder = None
+        self._z_explicit = None
+
+    def build_resets(self, compiled):
+        """Reset maps x+ (scaled for the target mode) of every event; needs all modes compiled."""
+        mode = self._mode
+        self.resets = []
+        for ev in mode.events:
+            target = compiled[ev.target]._mode
+            reset = dict(ev.reset or {})
+            unknown = sorted(set(reset) - set(target.x))
+            if unknown:
+                raise ModelError(f"mode '{mode.name}', event '{ev.name}': reset names {unknown} are not states "
+                                 f"of target mode '{target.name}' ({list(target.x)})")
+            exprs = []
+            for name in target.x:
+                if name in reset:
+                    exprs.append(ca.SX(reset[name]))
+                elif name in mode.x:
+                    exprs.append(mode.x[name])
+                else:
+                    raise ModelError(f"mode '{mode.name}', event '{ev.name}': target mode '{target.name}' has "
+                                     f"state '{name}' that the source mode lacks; give it in reset=")
+            old = _column(list(mode.x.values()) + list(mode.z.values()))
+            new = ca.vertcat(self.xs * ca.DM(mode.x_nominal), self.zs * ca.DM(mode.z_nominal)) \
+                if self.nz else self.xs * ca.DM(mode.x_nominal)
+            expr = ca.substitute(_column(exprs), old, new) / ca.DM(target.x_nominal)
+            self.resets.append(_function(f"{mode.name}_reset_{ev.name}", [self.xs, self.zs, self.pu, self.t],
+                                         [expr], f"the reset of event '{ev.name}'", mode.name))
+
+    # ----------------------------------------------------------------- algebraic variables
+    def rootfinder(self):
+        """``rf(zs_guess, xs, pu, t) -> zs`` solving the algebraic equations (CasADi Newton)."""
+        if self._rootfinder is None:
+            g = ca.Function(f"{self.name}_g", [self.zs, self.xs, self.pu, self.t], [self.alg_s])
+            self._rootfinder = ca.rootfinder(f"{self.name}_rf", "newton", g,
+                                             {"abstol": 1e-13, "abstolStep": 1e-14, "max_iter": 100,
+                                              "error_on_fail": False})
+        return self._rootfinder
+
+    def consistent_z(self, xs, pu, t, guess=None):
+        """Scaled algebraic variables solving ``alg = 0`` at ``(xs, pu, t)`` (Newton from ``guess``)."""
+        if not self.nz:
+            return np.zeros(0)
+        guess = self.z_guess_scaled if guess is None else np.asarray(guess, float)
+        rf = self.rootfinder()
+        zs = np.array(rf(guess, xs, pu, t), dtype=float).ravel()
+        if not (rf.stats()["success"] and np.all(np.isfinite(zs))):
+            residual = np.array(self.f_alg(xs, zs, pu, t), dtype=float).ravel()
+            from clutchocp.simulation.diagnostics import solver_error
+            raise solver_error("the consistent-initialisation Newton solve", "no_convergence", t, self,
+                               xs, zs, detail=f"; largest scaled residual {np.max(np.abs(residual)):.3g}")
+        return zs
+
+    def z_explicit(self):
+        """``zs(xs, pu, t)`` when the residuals are linear in z (solved symbolically), else None."""
+        if self._z_explicit is None:
+            if self.nz and ca.is_linear(self.alg_s, self.zs):
+                a = ca.jacobian(self.alg_s, self.zs)
+                b = ca.substitute(self.alg_s, self.zs, ca.DM.zeros(self.nz))
+                zs = -ca.solve(a, b)
+                self._z_explicit = ca.Function(f"{self.name}_z", [self.xs, self.pu, self.t], [zs])
+            else:
+                self._z_explicit = False
+        return self._z_explicit or None
+
+    # ----------------------------------------------------------------- conversions
+    def x_dict(self, xs):
+        """Unscaled state values by name."""
+        xs = np.asarray(xs, float).reshape(self.nx)
+        return dict(zip(self.x_names, xs * self.x_nominal))
+
+    def z_dict(self, zs):
+        """Unscaled algebraic values by name."""
+        zs = np.asarray(zs, float).reshape(self.nz)
+        return dict(zip(self.z_names, zs * self.z_nominal))
+
+
+def compile_model(model):
+    """Compile every mode of a :class:`~clutchocp.simulation.model.HybridModel`."""
+    compiled = {name: CompiledMode(mode, model) for name, mode in model.modes.items()}
+    for cm in compiled.values():
+        cm.build_resets(compiled)
+    return compiled

@@ -1,0 +1,257 @@
+"""The hybrid simulation loop: pieces between input breaks, events, resets, restarts."""
+
+import time
+
+import numpy as np
+
+from clutchocp.errors import ModelError, SolverError
+from clutchocp.simulation.events import ARMED, PASSED, EventMonitor
+from clutchocp.simulation.idas_path import IdasPath
+from clutchocp.simulation.model import PiecewiseConstant
+from clutchocp.simulation.options import METHODS, SimulationOptions
+from clutchocp.simulation.result import EventRecord, Segment, SimulationResult
+from clutchocp.simulation.scipy_path import ScipyPath
+
+
+def simulate(model, x0, grid, *, mode=None, p=None, u=None, z_guess=None, method="idas", options=None):
+    """Simulate a hybrid DAE over an output grid.
+
+    Parameters
+    ----------
+    model : HybridModel
+        The modes, parameters, inputs and time symbol.
+    x0 : mapping of str to float
+        Initial value of every state of the initial mode (unscaled units).
+    grid : array_like of float
+        Increasing output times [s]; the run goes from ``grid[0]`` to ``grid[-1]``. Events
+        are detected between consecutive grid points, so the grid must resolve the events
+        (two crossings of one function within one interval cancel).
+    mode : str, optional
+        Initial mode (default: the model's first mode).
+    p : mapping of str to float, optional
+        Value of every parameter.
+    u : mapping of str to float or PiecewiseConstant, optional
+        Value or schedule of every input.
+    z_guess : mapping of str to float, optional
+        Starting guess for the initial algebraic variables (default: the mode's z_guess).
+    method : {"idas", "Radau", "BDF", "LSODA"}
+        "idas" integrates the DAE with CasADi IDAS; the others integrate the ODE obtained by
+        eliminating z with scipy's ``solve_ivp`` (a cross-check path).
+    options : SimulationOptions, optional
+        Tolerances and limits.
+
+    Returns
+    -------
+    SimulationResult
+
+    Raises
+    ------
+    ModelError
+        Missing or unknown initial values, parameters or inputs; a bad grid.
+    SolverError
+        The integrator, the consistent initialisation or the event location failed, or the
+        modes chatter; the message says when, in which mode, why and what to try.
+    """
+    wall_start = time.perf_counter()
+    opts = options or SimulationOptions()
+    if method not in METHODS:
+        raise ModelError(f"method must be one of {METHODS}, got {method!r}")
+    compile_start = time.perf_counter()
+    compiled = model.compiled()                     # built once per model, then cached
+    compile_time = time.perf_counter() - compile_start
+    grid = np.asarray(grid, dtype=float).ravel()
+    if grid.size < 2 or not np.all(np.isfinite(grid)) or np.any(np.diff(grid) <= 0):
+        raise ModelError("grid must hold at least two finite, strictly increasing times")
+    mode = model.initial_mode if mode is None else mode
+    if mode not in compiled:
+        raise ModelError(f"unknown initial mode '{mode}'; modes: {list(compiled)}")
+    run = _Run(compiled, grid, opts, _make_path(method, opts), _inputs(model, p, u, grid))
+    cm = compiled[mode]
+    xs0 = _initial_state(cm, x0)
+    guess = None
+    if z_guess is not None:
+        unknown = sorted(set(z_guess) - set(cm.z_names))
+        if unknown:
+            raise ModelError(f"z_guess names {unknown} are not algebraic variables of mode '{cm.name}'")
+        guess = np.array([z_guess[n] / s if n in z_guess else g
+                          for n, s, g in zip(cm.z_names, cm.z_nominal, cm.z_guess_scaled)], dtype=float)
+    run.start(cm, xs0, guess)
+    run.loop()
+    stats = run.path.stats()
+    stats.update(method=method, n_switches=len(run.events), n_event_iterations=run.event_iterations,
+                 wall_time_s=time.perf_counter() - wall_start, compile_time_s=compile_time, options=opts.as_dict())
+    return SimulationResult.from_segments(run.segments(), run.events, stats)
+
+
+def _make_path(method, opts):
+    return IdasPath(opts) if method == "idas" else ScipyPath(method, opts)
+
+
+def _initial_state(cm, x0):
+    x0 = dict(x0)
+    missing = [n for n in cm.x_names if n not in x0]
+    unknown = sorted(set(x0) - set(cm.x_names))
+    if missing or unknown:
+        raise ModelError(f"x0 of mode '{cm.name}' must give exactly {cm.x_names}; missing {missing}, unknown {unknown}")
+    xs0 = np.array([float(x0[n]) for n in cm.x_names]) / cm.x_nominal
+    if not np.all(np.isfinite(xs0)):
+        raise ModelError(f"x0 must be finite, got {x0}")
+    return xs0
+
+
+class _Inputs:
+    """Parameter + input vector as a function of time, and the input break times."""
+
+    def __init__(self, fixed, schedules, breaks):
+        self.fixed, self.schedules, self.breaks = fixed, schedules, breaks
+
+    def at(self, t):
+        return np.array(self.fixed + [s(t) if isinstance(s, PiecewiseConstant) else s for s in self.schedules])
+
+
+def _inputs(model, p, u, grid):
+    p, u = dict(p or {}), dict(u or {})
+    for kind, given, declared in (("parameter", p, model.p), ("input", u, model.u)):
+        missing = [n for n in declared if n not in given]
+        unknown = sorted(set(given) - set(declared))
+        if missing or unknown:
+            raise ModelError(f"{kind} values must give exactly {list(declared)}; missing {missing}, unknown {unknown}")
+    fixed = [float(p[n]) for n in model.p]
+    schedules = [u[n] if isinstance(u[n], PiecewiseConstant) else float(u[n]) for n in model.u]
+    tiny = 1e-12 * max(1.0, abs(grid[-1]))
+    breaks = sorted({float(b) for s in schedules if isinstance(s, PiecewiseConstant) for b in s.breaks
+                     if grid[0] + tiny < b < grid[-1] - tiny})
+    values = fixed + [v for s in schedules for v in np.ravel(s.values if isinstance(s, PiecewiseConstant) else s)]
+    if not np.all(np.isfinite(values)):
+        raise ModelError("parameter and input values must be finite")
+    return _Inputs(fixed, schedules, breaks)
+
+
+class _Run:
+    """State of one hybrid simulation."""
+
+    def __init__(self, compiled, grid, opts, path, inputs):
+        self.compiled, self.grid, self.opts, self.path, self.inputs = compiled, grid, opts, path, inputs
+        self.tiny = 1e-12 * max(1.0, abs(grid[-1]))
+        self.events, self.event_iterations = [], 0
+        self._segments = []        # [cm, [t], [xs], [zs], [pu]]
+        self._instant = (None, 0)  # (time of the last switch, switches at that time)
+
+    # ------------------------------------------------------------- samples
+    def _begin(self, cm):
+        self._segments.append([cm, [], [], [], []])
+
+    def _add(self, t, xs, zs, pu):
+        seg = self._segments[-1]
+        seg[1].append(float(t)), seg[2].append(np.asarray(xs, float)), seg[3].append(np.asarray(zs, float))
+        seg[4].append(pu)
+
+    def segments(self):
+        out = []
+        for cm, ts, xs, zs, pus in self._segments:
+            n = len(ts)
+            t = np.array(ts)
+            xs = np.array(xs, float).T.reshape(cm.nx, n)
+            zs = np.array(zs, float).T.reshape(cm.nz, n)
+            pu = np.array(pus, float).T.reshape(-1, n)
+            y = np.array(cm.f_outputs(xs, zs, pu, t.reshape(1, -1)), float).reshape(len(cm.output_names), n) \
+                if n else np.zeros((len(cm.output_names), 0))
+            out.append(Segment(cm.name, t,
+                               {k: xs[j] * cm.x_nominal[j] for j, k in enumerate(cm.x_names)},
+                               {k: zs[j] * cm.z_nominal[j] for j, k in enumerate(cm.z_names)},
+                               {k: y[j] for j, k in enumerate(cm.output_names)}))
+        return out
+
+    # ------------------------------------------------------------- mode entry and switches
+    def start(self, cm, xs, z_guess):
+        self.t, self.pu = float(self.grid[0]), self.inputs.at(self.grid[0])
+        self.cm, self.xs = cm, xs
+        self.zs = cm.consistent_z(xs, self.pu, self.t, z_guess)
+        self._begin(cm)
+        self._add(self.t, self.xs, self.zs, self.pu)
+        self._enter()
+
+    def _enter(self):
+        """Arm the current mode's events; switch at once while one is already past its zero."""
+        while True:
+            cm = self.cm
+            self.monitor = EventMonitor(cm.events, self.opts.event_band)
+            if not cm.events:
+                return
+            s = np.array(cm.f_events(self.xs, self.zs, self.pu, self.t), float).ravel()
+            ok = np.array(cm.f_guards(self.xs, self.zs, self.pu, self.t), float).ravel() >= 0
+            fire = self.monitor.enter(s, ok)
+            if fire is None:
+                return
+            self._switch(fire, iterations=0)
+
+    def _switch(self, i, iterations):
+        cm, spec, t = self.cm, self.cm.events[i], self.t
+        last, count = self._instant
+        count = count + 1 if last is not None and abs(t - last) <= self.opts.event_time_tol else 1
+        self._instant = (t, count)
+        if count > self.opts.max_instant_switches:
+            modes = " -> ".join(e.source for e in self.events[-count + 1:]) + f" -> {spec.target}"
+            raise SolverError(f"mode chatter at t = {t:.12g} s: {count} switches without time passing ({modes}). "
+                              "The events of these modes contradict each other at this state. Try: give the events "
+                              "guards that exclude each other (e.g. lock only when the needed torque is within the "
+                              "static capacity), or a larger event_band.")
+        if len(self.events) >= self.opts.max_switches:
+            raise SolverError(f"more than max_switches = {self.opts.max_switches} mode switches by t = {t:.12g} s "
+                              f"(last: '{spec.name}' from '{cm.name}' to '{spec.target}'). Try: check the events "
+                              "for chatter, or raise max_switches.")
+        target = self.compiled[spec.target]
+        xs_new = np.array(cm.resets[i](self.xs, self.zs, self.pu, t), float).ravel()
+        known = cm.z_dict(self.zs)
+        guess = np.array([known[n] / s if n in known else g
+                          for n, s, g in zip(target.z_names, target.z_nominal, target.z_guess_scaled)])
+        zs_new = target.consistent_z(xs_new, self.pu, t, guess)
+        self.events.append(EventRecord(spec.name, t, cm.name, target.name, cm.x_dict(self.xs), target.x_dict(xs_new),
+                                       cm.z_dict(self.zs), target.z_dict(zs_new), self._outputs(cm, self.xs, self.zs),
+                                       self._outputs(target, xs_new, zs_new), iterations))
+        self.cm, self.xs, self.zs = target, xs_new, zs_new
+        self._begin(target)
+        self._add(t, xs_new, zs_new, self.pu)
+
+    def _outputs(self, cm, xs, zs):
+        values = np.array(cm.f_outputs(xs, zs, self.pu, self.t), float).ravel()
+        return dict(zip(cm.output_names, values))
+
+    # ------------------------------------------------------------- main loop
+    def loop(self):
+        t_final = self.grid[-1]
+        while self.t < t_final - self.tiny:
+            t_end = next((b for b in self.inputs.breaks if b > self.t + self.tiny), t_final)
+            inner = self.grid[(self.grid > self.t + self.tiny) & (self.grid < t_end - self.tiny)]
+            times = np.append(inner, t_end)
+            adv = self.path.advance(self.cm, self.t, self.xs, self.zs, self.pu, times, self.monitor)
+            for j in range(adv.t.size):
+                self._add(adv.t[j], adv.xs[:, j], adv.zs[:, j], self.pu)
+            crossing = adv.crossing
+            if crossing is None:
+                self.t, self.xs, self.zs = t_end, adv.xs[:, -1], adv.zs[:, -1]
+                if t_end < t_final:
+                    self._input_break()
+                continue
+            self.t, self.xs, self.zs = crossing.t, np.asarray(crossing.xs, float), np.asarray(crossing.zs, float)
+            self.event_iterations += crossing.iterations
+            if crossing.kind == "rearm":
+                for i in crossing.events:
+                    self.monitor.state[i] = ARMED
+                continue
+            guards = np.array(self.cm.f_guards(self.xs, self.zs, self.pu, self.t), float).ravel()
+            fired = next((i for i in crossing.events if guards[i] >= 0), None)
+            if fired is None:
+                for i in crossing.events:
+                    self.monitor.state[i] = PASSED
+                continue
+            self._add(self.t, self.xs, self.zs, self.pu)
+            self._switch(fired, crossing.iterations)
+            self._enter()
+
+    def _input_break(self):
+        """Inputs jump at self.t: new consistent z, a sample on each side, events re-armed."""
+        self.pu = self.inputs.at(self.t)
+        self.zs = self.cm.consistent_z(self.xs, self.pu, self.t, self.zs)
+        self._add(self.t, self.xs, self.zs, self.pu)
+        self._enter()

@@ -1,0 +1,82 @@
+"""Settings of a hybrid simulation (shared by the IDAS and scipy paths)."""
+
+from dataclasses import asdict, dataclass, field
+
+from clutchocp.errors import ModelError
+
+METHODS = ("idas", "Radau", "BDF", "LSODA")
+
+
+@dataclass
+class SimulationOptions:
+    """Tolerances and limits of :func:`clutchocp.simulation.simulate`.
+
+    Parameters
+    ----------
+    rtol, atol : float
+        Relative and absolute integration tolerances; ``atol`` applies to the *scaled*
+        variables ``x / x_nominal`` (and ``z / z_nominal`` for IDAS).
+    suppress_algebraic : bool
+        IDAS only: leave the algebraic variables out of the error test. Needed when an input
+        written into the equations (e.g. ``if_else(t >= t1, ...)``) jumps inside an
+        integration interval; a :class:`~clutchocp.simulation.model.PiecewiseConstant` input
+        is the better fix (the run restarts at its breaks).
+    max_num_steps : int
+        IDAS step limit per call.
+    max_step : float or None
+        Largest step [s] (None: unlimited).
+    event_time_tol : float
+        An event is located when its bracket is this short [s] ...
+    event_value_tol : float
+        ... or when |event function / scale| is at most this.
+    event_band : float
+        Hysteresis band on the scaled event functions (see ``README-engine.md``): an event
+        whose function is within the band when its mode is entered is disarmed until the
+        function leaves the band; leaving on the firing side fires it.
+    max_switches : int
+        Most mode switches in one simulation.
+    max_instant_switches : int
+        Most switches at one instant (zero dwell) before the run is declared chattering.
+    chunk : int or None
+        IDAS: output intervals per integrator call (None: the rest of the piece at once).
+        Smaller values waste less work past an event at the price of more restarts (each
+        restart costs steps and some accuracy; measured on the tests: None is best there).
+    chunk_growth : float or None
+        IDAS: multiply the chunk by this after every call that saw no event (e.g. 2.0 with a
+        small ``chunk``: few restarts, bounded waste past an event).
+    idas_options : dict
+        Extra options passed to ``casadi.integrator(..., "idas", ...)``.
+    """
+
+    rtol: float = 1e-8
+    atol: float = 1e-8
+    suppress_algebraic: bool = False
+    max_num_steps: int = 20000
+    max_step: float | None = None
+    event_time_tol: float = 1e-9
+    event_value_tol: float = 1e-6
+    event_band: float = 1e-5
+    max_switches: int = 100
+    max_instant_switches: int = 5
+    chunk: int | None = None
+    chunk_growth: float | None = None
+    idas_options: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        for name in ("rtol", "atol", "event_time_tol", "event_value_tol", "event_band"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and value > 0):
+                raise ModelError(f"SimulationOptions.{name} must be a positive number, got {value!r}")
+        if self.event_band <= self.event_value_tol:
+            raise ModelError("SimulationOptions.event_band must exceed event_value_tol "
+                             f"({self.event_band} <= {self.event_value_tol})")
+        if self.max_step is not None and not self.max_step > 0:
+            raise ModelError(f"SimulationOptions.max_step must be positive or None, got {self.max_step!r}")
+        if self.chunk is not None and not (isinstance(self.chunk, int) and self.chunk >= 1):
+            raise ModelError(f"SimulationOptions.chunk must be a positive integer or None, got {self.chunk!r}")
+        if self.chunk_growth is not None and not self.chunk_growth >= 1:
+            raise ModelError(f"SimulationOptions.chunk_growth must be >= 1 or None, got {self.chunk_growth!r}")
+
+    def as_dict(self):
+        """Plain dictionary (for summaries)."""
+        return asdict(self)

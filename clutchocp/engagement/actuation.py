@@ -29,13 +29,15 @@ def _read_table(path, field):
 class Actuation:
     """Engagement pressure from the scene's [actuation] part.
 
-    Publishes ``command(t)`` (the set pressure as a function of time) and ``pressure(t, p_state)``.
+    Publishes ``command(t)`` (the set pressure as a function of time, or a control symbol) and
+    ``pressure(t, p_state)``.
     The ``valve_lag`` variant adds one state, the valve output pressure, with
     dp/dt = (command - p) / time_constant; the others have no state.
     """
 
-    def __init__(self, scene):
+    def __init__(self, scene, command=None):
         self.variant = scene.variant("actuation")
+        self.control = command
         self.p_set = scene.value("actuation.pressure")
         self.p_initial = scene.value("actuation.initial_pressure")
         self.t_start = scene.value("actuation.t_start")
@@ -47,7 +49,13 @@ class Actuation:
         self.has_state = self.variant == "valve_lag"
 
     def command(self, t):
-        """Commanded (or prescribed) pressure [Pa] at time t (SX or float)."""
+        """Commanded (or prescribed) pressure [Pa] at time t (SX or float).
+
+        With a ``command`` symbol given to the constructor (the control of an optimal-control
+        problem), that symbol is the command and the scene's profile is not used.
+        """
+        if self.control is not None:
+            return self.control
         dp = self.p_set - self.p_initial
         tau = t - self.t_start
         on = ca.if_else(tau >= 0, 1.0, 0.0)

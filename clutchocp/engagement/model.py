@@ -40,9 +40,13 @@ class EngagementModel:
         An engagement scene.
     smooth : bool
         Smooth forms of the switching laws (for the optimal-control problem).
+    pressure_command : casadi.SX, optional
+        A scalar symbol that replaces the scene's pressure profile as the commanded pressure
+        [Pa] (the control of the optimal-control problem). With the ``valve_lag`` actuation it
+        drives the valve state; otherwise it is the pressure itself.
     """
 
-    def __init__(self, scene, smooth=False):
+    def __init__(self, scene, smooth=False, pressure_command=None):
         if scene.kind != "engagement":
             raise ModelError(f"scene '{scene.name}' is a {scene.kind} scene; an engagement needs kind = 'engagement'")
         if scene.get("driveline.shaft_stiffness") is not None:
@@ -50,7 +54,7 @@ class EngagementModel:
                              "engagement model yet; remove the key to treat the shaft as rigid")
         self.scene = scene
         self.film = FilmLaw(scene, smooth=smooth)
-        self.actuation = Actuation(scene)
+        self.actuation = Actuation(scene, command=pressure_command)
         self.n = scene.value("plates.n_interfaces")
         self.H0 = scene.value("pack.initial_gap")
         self.sigma = self.film.sigma if self.film.sigma > 0 else self.H0 / 10
@@ -70,7 +74,8 @@ class EngagementModel:
             for rotation in ROTATIONS:
                 mode = self._build_mode(axial, rotation)
                 self.modes[mode.name] = mode
-        self.hybrid = HybridModel(list(self.modes.values()), t=self.t)
+        inputs = {"pressure_command": pressure_command} if pressure_command is not None else None
+        self.hybrid = HybridModel(list(self.modes.values()), u=inputs, t=self.t)
 
     # -- states -------------------------------------------------------------------------------
     def _build_states(self):

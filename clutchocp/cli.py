@@ -56,6 +56,13 @@ def _cmd_simulate(args):
     return 0
 
 
+def _cmd_control(args):
+    from .hvd.report import run_control
+
+    run_control(args.scene, args.controller, out_dir=args.out)
+    return 0
+
+
 def build_parser():
     """The argument parser of the ``clutchocp`` command."""
     parser = argparse.ArgumentParser(
@@ -79,6 +86,11 @@ def build_parser():
     p.add_argument("--method", default="idas", choices=("idas", "Radau", "BDF", "LSODA"),
                    help="integrator (default: idas)")
     p.set_defaults(run=_cmd_simulate)
+    p = sub.add_parser("control", help="hydro-viscous drive: operating points, linearisation, speed controller, closed loop")
+    p.add_argument("scene", help="an hvd scene (e.g. liao2021_hvd, cui2019_hvd) or TOML file")
+    p.add_argument("--controller", default=None, help="controller spec name (lqi, pi) or TOML file (default: lqi)")
+    p.add_argument("--out", default="out/control", help="output folder (default: out/control)")
+    p.set_defaults(run=_cmd_control)
     return parser
 
 

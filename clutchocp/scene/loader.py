@@ -32,14 +32,54 @@ ANALYSIS_PARTS = {
 }
 
 
-def builtin_scene_dir():
-    """Folder of the built-in scenes: inside the installed package, or models/ of a source tree."""
+def builtin_dir(folder):
+    """A data folder (``models`` or ``controllers``): inside the installed package, or at the top of
+    a source tree."""
     package = Path(__file__).resolve().parent.parent
-    installed = package / "_data" / "models"
-    return installed if installed.is_dir() else package.parent / "models"
+    installed = package / "_data" / folder
+    return installed if installed.is_dir() else package.parent / folder
+
+
+def builtin_scene_dir():
+    """Folder of the built-in scenes."""
+    return builtin_dir("models")
+
+
+def read_toml(name_or_path, folder, what):
+    """Read a TOML file given by path, or by built-in name from ``builtin_dir(folder)``.
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path
+    folder : str
+        ``"models"`` or ``"controllers"``.
+    what : str
+        What the file is, for messages (``"scene"``, ``"controller"``).
+
+    Returns
+    -------
+    (pathlib.Path, dict)
+    """
+    path = Path(name_or_path)
+    if not path.is_file():
+        candidate = builtin_dir(folder) / f"{name_or_path}.toml"
+        if not candidate.is_file():
+            names = sorted(p.stem for p in builtin_dir(folder).glob("*.toml"))
+            raise SceneNotFoundError(
+                f"{what} '{name_or_path}': no such file and no built-in {what} of that name"
+                f"{_suggest(str(name_or_path), names)} (built-in: {', '.join(names)})"
+            )
+        path = candidate
+    try:
+        return path, tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path.name}: not valid TOML ({exc})") from None
+    except UnicodeDecodeError:
+        raise SceneError(f"{path.name}: not a UTF-8 text file") from None
 
 
 def _suggest(word, options):
+    """"; did you mean 'x'?" for the closest of ``options``, or an empty string."""
     close = difflib.get_close_matches(word, list(options), n=1, cutoff=0.5)
     return f"; did you mean '{close[0]}'?" if close else ""
 
@@ -322,22 +362,7 @@ def load_scene(name_or_path, overrides=None):
     -------
     Scene
     """
-    path = Path(name_or_path)
-    if not path.is_file():
-        candidate = builtin_scene_dir() / f"{name_or_path}.toml"
-        if not candidate.is_file():
-            names = [s.stem for s in builtin_scene_dir().glob("*.toml")]
-            raise SceneNotFoundError(
-                f"scene '{name_or_path}': no such file and no built-in scene of that name"
-                f"{_suggest(str(name_or_path), names)} (built-in: {', '.join(sorted(names))})"
-            )
-        path = candidate
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path.name}: not valid TOML ({exc})") from None
-    except UnicodeDecodeError:
-        raise SceneError(f"{path.name}: not a UTF-8 text file") from None
+    path, raw = read_toml(name_or_path, "models", "scene")
     scene = Scene(raw, path)
     return scene.with_overrides(overrides) if overrides else scene
 

@@ -314,12 +314,39 @@ PARTS = {
                                    doc="number of output times"),
         },
     ),
+    "hvd": Part(
+        "hydro-viscous drive control piston, springs (Liao Eq. 15) and pressure valve",
+        fields={
+            "cylinder_r_inner": Q("m", doc="inner radius R1 of the control-oil cylinder [m] (Liao Eq. 15)"),
+            "cylinder_r_outer": Q("m", doc="outer radius R2 of the control-oil cylinder [m] (Liao Eq. 15)"),
+            "spring_stiffness": Q("N/m", doc="stiffness k of one spring [N/m]"),
+            "spring_count": Field(kind="int", check="positive", required=False, default=1,
+                                  doc="number of springs N"),
+            "spring_preload": QOpt("m", 0.0, doc="spring precompression x0 [m]"),
+            "control_oil_radius": QOpt("m", None, "nonnegative",
+                                       "free-surface radius r0 of the rotating control oil [m] (Liao Eq. 15); "
+                                       "absent: no centrifugal cylinder force"),
+            "valve_time_constant": Q("s", doc="time constant of the pressure valve [s] (a state)"),
+            "pressure_min": QOpt("Pa", 0.0, doc="lowest control pressure the valve gives [Pa]"),
+            "pressure_max": Q("Pa", doc="highest control pressure the valve gives [Pa]"),
+            "spline_friction": QOpt("1", None, "friction",
+                                    "friction coefficient f of the plates in their splines (Liao Eq. 10); "
+                                    "needed with [hvc]"),
+        },
+        variants={
+            "spring_applied": {},
+            "pressure_applied": {
+                "open_clearance": Q("m", doc="total pack clearance with the piston on its stop [m]"),
+            },
+        },
+        default_variant="pressure_applied",
+    ),
 }
 
 # Parts a scene of each kind must declare.
 REQUIRED_PARTS = {
     "engagement": ("scene", "plates", "oil", "roughness", "contact", "friction", "pack",
                    "actuation", "driveline", "simulation"),
-    "hvd": ("scene", "plates", "oil"),
+    "hvd": ("scene", "plates", "oil", "hvd", "driveline", "load"),
     "static": ("scene", "plates"),
 }

@@ -31,7 +31,7 @@ class EngagementResult:
 
 
 def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=None, output_points=None,
-                        model=None):
+                        model=None, native=False):
     """Simulate an engagement scene through impact, slip and lock-up.
 
     Parameters
@@ -49,7 +49,12 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     output_points : int, optional
         Number of output times (default: simulation.output_points).
     model : EngagementModel, optional
-        A model already built for this scene (saves the symbolic assembly).
+        A model already built for this scene (saves the symbolic assembly; a second run of the
+        same model also reuses its compiled functions and IDAS integrators).
+    native : bool
+        IDAS: evaluate the equations and outputs as compiled machine code
+        (:class:`~clutchocp.simulation.SimulationOptions` ``native``; same results, ~30 % faster
+        runs, ~0.3 s of compilation per mode the first time).
 
     Returns
     -------
@@ -58,11 +63,11 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     model = model or EngagementModel(scene)
     t_end = t_end or scene.value("simulation.t_end")
     n_out = output_points or scene.value("simulation.output_points")
-    # Chunks of 32 output intervals, doubling while no event comes: after an event the work done
-    # past it is thrown away, and the free piston of the approach phase, say, would otherwise be
-    # integrated to the end of the run (measured on bao2020: 72 000 steps unchunked, 3 600 chunked).
+    # IDAS calls end just past the predicted next event (simulation/idas_path.py): the free piston
+    # of the approach phase is not integrated past its impact (bao2020: 2 000 steps in all; fixed
+    # chunks of 32 intervals took 3 600, one call per piece 72 000).
     options = SimulationOptions(rtol=rtol or scene.value("simulation.rtol"),
-                                atol=atol or scene.value("simulation.atol"), chunk=32, chunk_growth=2.0)
+                                atol=atol or scene.value("simulation.atol"), native=native)
     grid = np.unique(np.concatenate([np.linspace(0.0, t_end, n_out),
                                      [b for b in model.actuation.breakpoints() if b < t_end]]))
     x0 = dict(zip(model.state_names, model.initial_state))
@@ -96,7 +101,7 @@ def response_times(model, result):
     rise = lambda frac: _first_crossing(t, (p - p0) / (p_set - p0), frac) if p_set != p0 else None  # noqa: E731
     t10, t50, t90 = rise(0.1), rise(0.5), rise(0.9)
     pressure_time = t90 - t10 if t10 is not None and t90 is not None else None
-    slipping = np.array([not str(m).endswith("locked") for m in result.mode])
+    slipping = ~np.char.endswith(result.mode.astype(str), "locked")
     torque = np.abs(result["total_torque_Nm"])
     torque_time = None
     if t50 is not None and slipping.any():

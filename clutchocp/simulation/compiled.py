@@ -2,7 +2,10 @@
 
 Every function takes ``(xs, zs, pu, t)`` with ``xs = x / x_nominal``, ``zs = z / z_nominal``,
 ``pu`` = parameters followed by inputs, in model order. Both integrator paths (IDAS and
-scipy) use exactly these functions, so they integrate the same equations.
+scipy) use exactly these functions, so they integrate the same equations. Every expression is
+passed through ``casadi.cse`` (common subexpressions evaluated once): a model assembled from
+parts repeats many terms (e.g. a contact force feeds the film load, the torque, the capacity
+and the energy rates), and the shared form halves the cost of the right-hand side.
 """
 
 from dataclasses import dataclass
@@ -11,6 +14,7 @@ import casadi as ca
 import numpy as np
 
 from clutchocp.errors import ModelError
+from clutchocp.simulation.model import time_derivative
 
 
 @dataclass(frozen=True)
@@ -37,6 +41,51 @@ def _function(name, inputs, outputs, what, mode):
                          "its states, its algebraic variables, the model parameters, inputs nor time") from None
 
 
+class ColumnFunction:
+    """A Function of ``(xs, zs, pu, t)`` evaluated on many samples at once.
+
+    A CasADi ``map`` over the columns of ``xs, zs, t`` (``pu`` shared), called through the
+    buffer interface: numpy arrays in and out, no DM conversions (which cost more than the
+    evaluation for a few thousand samples of a small function).
+    """
+
+    def __init__(self, function, max_maps=16):
+        if not all(function.sparsity_in(i).is_dense() for i in range(4)) or not function.sparsity_out(0).is_dense():
+            raise ModelError(f"{function.name()}: a column function needs dense inputs and output (densify them)")
+        self.function = function
+        self.sizes = [function.size1_in(i) for i in range(4)]
+        self.n_out = function.size1_out(0)
+        self._maps = {}
+        self._max_maps = max_maps
+
+    def _map(self, n):
+        entry = self._maps.pop(n, None)
+        if entry is None:
+            mapped = self.function.map(f"{self.function.name()}_columns", "serial", n, [2], [])
+            entry = (mapped, *mapped.buffer())
+        self._maps[n] = entry                      # most recently used last
+        if len(self._maps) > self._max_maps:
+            self._maps.pop(next(iter(self._maps)))
+        return entry
+
+    def __call__(self, xs, zs, pu, t):
+        """Outputs on the samples: array (n_out, n) for ``t`` of length n."""
+        t = np.atleast_1d(np.asarray(t, float)).ravel()
+        n = t.size
+        nx, nz = self.sizes[:2]
+        _, buf, evaluate = self._map(n)
+        args = [np.ascontiguousarray(np.reshape(np.asarray(xs, float), (nx, n)).T),
+                np.ascontiguousarray(np.reshape(np.asarray(zs, float), (nz, n)).T),
+                np.ascontiguousarray(np.ravel(np.asarray(pu, float))), t.copy()]
+        out = np.zeros((n, self.n_out))
+        dummy = np.zeros(1)
+        for i, a in enumerate(args):
+            buf.set_arg(i, memoryview(a if a.size else dummy))
+        buf.set_res(0, memoryview(out if out.size else dummy))
+        evaluate()
+        return out.T
+
+
 class CompiledMode:
     """The scaled DAE, events, guards, resets and outputs of one mode as CasADi Functions."""
 
@@ -60,14 +109,15 @@ class CompiledMode:
             if self.nz else self.xs * ca.DM(mode.x_nominal)
 
         def scaled(exprs):
-            return ca.substitute(_column(exprs), old, new)
+            return ca.cse(ca.substitute(_column(exprs), old, new))
 
-        self.ode_s = scaled(mode.ode) / ca.DM(mode.x_nominal)
-        self.alg_s = scaled(mode.alg) / ca.DM(mode.alg_nominal) if self.nz else ca.SX(0, 1)
+        self.ode_s = ca.cse(scaled(mode.ode) / ca.DM(mode.x_nominal))
+        self.alg_s = ca.cse(scaled(mode.alg) / ca.DM(mode.alg_nominal)) if self.nz else ca.SX(0, 1)
         self.f_ode = _function(f"{self.name}_ode", args, [self.ode_s], "the ode", self.name)
         self.f_alg = _function(f"{self.name}_alg", args, [self.alg_s], "the algebraic equations", self.name)
-        self.f_outputs = _function(f"{self.name}_outputs", args, [scaled(list(mode.outputs.values()))],
+        self.f_outputs = _function(f"{self.name}_outputs", args, [ca.densify(scaled(list(mode.outputs.values())))],
                                    "an output", self.name)
+        self.outputs_on = ColumnFunction(self.f_outputs)
 
         # events: scaled functions, guards (>= 0 lets the event fire), shared-location keys
         self.events = []
@@ -78,7 +128,9 @@ class CompiledMode:
                         if e.scale == ev.scale and ca.is_equal(ca.SX(e.function), fun, 16)), i)
             self.events.append(EventSpec(i, ev.name, ev.direction, ev.target, key))
             functions.append(fun / ev.scale)
-        self.f_events = _function(f"{self.name}_events", args, [scaled(functions)], "an event function", self.name)
+        self.f_events = _function(f"{self.name}_events", args, [ca.densify(scaled(functions))], "an event function",
+                                  self.name)
+        self.events_on = ColumnFunction(self.f_events)
         guards = [ca.SX(1.0) if ev.guard is None else ca.SX(ev.guard) for ev in mode.events]
         self.f_guards = _function(f"{self.name}_guards", args, [scaled(guards)], "an event guard", self.name)
         self._mode = mode
@@ -90,8 +142,13 @@ class CompiledMode:
         self.dae_tau = {"x": self.xs, "z": self.zs, "p": ca.vertcat(self.pu, t0, dt), "t": tau,
                         "ode": dt * at(self.ode_s), "alg": at(self.alg_s)}
 
+        self._event_functions = scaled(functions)
         self._rootfinder = None
         self._z_explicit = None
+        self._event_slopes = None
+        self._native_dae = None
+        self._native_outputs_on = None
+        self.integrators = {}       # cached casadi integrators of this mode (see idas_path)
 
     def build_resets(self, compiled):
         """Reset maps x+ (scaled for the target mode) of every event; needs all modes compiled."""
@@ -119,6 +176,34 @@ class CompiledMode:
             expr = ca.substitute(_column(exprs), old, new) / ca.DM(target.x_nominal)
             self.resets.append(_function(f"{mode.name}_reset_{ev.name}", [self.xs, self.zs, self.pu, self.t],
                                          [expr], f"the reset of event '{ev.name}'", mode.name))
+
+    def event_slopes(self):
+        """Column function ``(xs, zs, pu, t) -> (3 n_events, n)``: the scaled event functions, then
+        their first, then their second time derivatives along the flow (to predict crossings)."""
+        if self._event_slopes is None:
+            x, ode = ca.vertsplit(self.xs), ca.vertsplit(self.ode_s)
+            z, alg = (ca.vertsplit(self.zs), ca.vertsplit(self.alg_s)) if self.nz else (None, None)
+            s = self._event_functions
+            s1 = time_derivative(s, x, ode, z=z, alg=alg, t=self.t) if s.numel() else s
+            s2 = time_derivative(s1, x, ode, z=z, alg=alg, t=self.t) if s.numel() else s
+            self._event_slopes = ColumnFunction(ca.Function(
+                f"{self.name}_event_slopes", [self.xs, self.zs, self.pu, self.t], [ca.densify(ca.cse(ca.vertcat(s, s1, s2)))]))
+        return self._event_slopes
+
+    def native_dae(self):
+        """``dae_tau`` compiled to machine code (see :mod:`clutchocp.simulation.native`), or None."""
+        if self._native_dae is None:
+            from clutchocp.simulation.native import native_dae
+            self._native_dae = native_dae(self) or False
+        return self._native_dae or None
+
+    def native_outputs_on(self):
+        """:attr:`outputs_on` with the outputs compiled to machine code (itself if that fails)."""
+        if self._native_outputs_on is None:
+            from clutchocp.simulation.native import compile_function
+            compiled = compile_function(self.f_outputs)
+            self._native_outputs_on = ColumnFunction(compiled) if compiled is not None else self.outputs_on
+        return self._native_outputs_on
 
     # ----------------------------------------------------------------- algebraic variables
     def rootfinder(self):

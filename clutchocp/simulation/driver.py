@@ -127,6 +127,19 @@ def _inputs(model, p, u, grid):
     return _Inputs(fixed, schedules, breaks)
 
 
+def _outputs_on(evaluate, xs, zs, blocks_pu, t):
+    """Outputs (``evaluate``: a mode's ColumnFunction) on all samples of a segment, one call per run
+    of equal inputs."""
+    y = np.zeros((evaluate.n_out, t.size))
+    start = 0
+    for pu, count in blocks_pu:
+        if count:
+            y[:, start:start + count] = evaluate(xs[:, start:start + count], zs[:, start:start + count], pu,
+                                                 t[start:start + count])
+        start += count
+    return y
+
+
 class _Run:
     """State of one hybrid simulation."""
 
@@ -139,23 +152,31 @@ class _Run:
 
     # ------------------------------------------------------------- samples
     def _begin(self, cm):
-        self._segments.append([cm, [], [], [], []])
+        self._segments.append([cm, []])          # blocks of (t (n,), xs (nx, n), zs (nz, n), pu (npu,))
 
     def _add(self, t, xs, zs, pu):
-        seg = self._segments[-1]
-        seg[1].append(float(t)), seg[2].append(np.asarray(xs, float)), seg[3].append(np.asarray(zs, float))
-        seg[4].append(pu)
+        self._add_block(np.array([float(t)]), xs, zs, pu)
+
+    def _add_block(self, t, xs, zs, pu):
+        n = np.size(t)
+        if n:
+            cm = self._segments[-1][0]
+            self._segments[-1][1].append((np.asarray(t, float).reshape(n), np.asarray(xs, float).reshape(cm.nx, n),
+                                          np.asarray(zs, float).reshape(cm.nz, n), np.asarray(pu, float)))
 
     def segments(self):
         out = []
-        for cm, ts, xs, zs, pus in self._segments:
-            n = len(ts)
-            t = np.array(ts)
-            xs = np.array(xs, float).T.reshape(cm.nx, n)
-            zs = np.array(zs, float).T.reshape(cm.nz, n)
-            pu = np.array(pus, float).T.reshape(-1, n)
-            y = np.array(cm.f_outputs(xs, zs, pu, t.reshape(1, -1)), float).reshape(len(cm.output_names), n) \
-                if n else np.zeros((len(cm.output_names), 0))
+        for cm, blocks in self._segments:
+            t = np.concatenate([b[0] for b in blocks]) if blocks else np.zeros(0)
+            xs = np.concatenate([b[1] for b in blocks], axis=1) if blocks else np.zeros((cm.nx, 0))
+            zs = np.concatenate([b[2] for b in blocks], axis=1) if blocks else np.zeros((cm.nz, 0))
+            runs = []
+            for b in blocks:                      # consecutive blocks with the same inputs share one call
+                if runs and np.array_equal(runs[-1][0], b[3]):
+                    runs[-1][1] += b[0].size
+                else:
+                    runs.append([b[3], b[0].size])
+            y = _outputs_on(cm.native_outputs_on() if self.opts.native else cm.outputs_on, xs, zs, runs, t)
             out.append(Segment(cm.name, t,
                                {k: xs[j] * cm.x_nominal[j] for j, k in enumerate(cm.x_names)},
                                {k: zs[j] * cm.z_nominal[j] for j, k in enumerate(cm.z_names)},
@@ -178,7 +199,7 @@ class _Run:
             self.monitor = EventMonitor(cm.events, self.opts.event_band)
             if not cm.events:
                 return
-            s = np.array(cm.f_events(self.xs, self.zs, self.pu, self.t), float).ravel()
+            s = cm.events_on(self.xs, self.zs, self.pu, self.t).ravel()
             ok = np.array(cm.f_guards(self.xs, self.zs, self.pu, self.t), float).ravel() >= 0
             fire = self.monitor.enter(s, ok)
             if fire is None:
@@ -225,8 +246,7 @@ class _Run:
             inner = self.grid[(self.grid > self.t + self.tiny) & (self.grid < t_end - self.tiny)]
             times = np.append(inner, t_end)
             adv = self.path.advance(self.cm, self.t, self.xs, self.zs, self.pu, times, self.monitor)
-            for j in range(adv.t.size):
-                self._add(adv.t[j], adv.xs[:, j], adv.zs[:, j], self.pu)
+            self._add_block(adv.t, adv.xs, adv.zs, self.pu)
             crossing = adv.crossing
             if crossing is None:
                 self.t, self.xs, self.zs = t_end, adv.xs[:, -1], adv.zs[:, -1]

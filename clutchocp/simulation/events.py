@@ -97,6 +97,46 @@ class EventMonitor:
     def commit(self, new_state):
         self.state = list(new_state)
 
+    def scan_block(self, s0, S):
+        """:meth:`scan` over consecutive samples: ``s0`` then the columns of ``S``.
+
+        Arming changes are committed as the samples are passed. Returns ``(j, crossings)``
+        for the first sample ``j`` whose step from the previous one crosses, else ``(None, [])``.
+        Only the samples at which some event changes state are examined one by one.
+        """
+        if not self.specs:
+            return None, []
+        S = np.asarray(S, float).reshape(len(self.specs), -1)
+        prev = np.column_stack([np.asarray(s0, float).reshape(-1, 1), S[:, :-1]])
+        j = 0
+        while j < S.shape[1]:
+            k = self._first_change(prev[:, j:], S[:, j:])
+            if k is None:
+                return None, []
+            j += k
+            crossings, new_state = self.scan(prev[:, j], S[:, j])
+            if crossings:
+                return j, crossings
+            self.commit(new_state)
+            j += 1
+        return None, []
+
+    def _first_change(self, A, B):
+        """Index of the first step (A[:, k] -> B[:, k]) at which :meth:`scan` would report a
+        crossing or change an arming state (None if there is none)."""
+        first = None
+        for i, spec in enumerate(self.specs):
+            d, a, b, st = spec.direction, A[i], B[i], self.state[i]
+            if st == ARMED:
+                hit = ((a > 0) & (b <= 0)) | ((a < 0) & (b >= 0)) if d == 0 else (d * a < 0) & (d * b >= 0)
+            else:
+                pre = np.abs(b) > self.band if d == 0 else d * b < -self.band
+                hit = pre | (d * b > self.band) if (st == ENTRY and d != 0) else pre
+            found = np.flatnonzero(hit)
+            if found.size and (first is None or found[0] < first):
+                first = int(found[0])
+        return first
+
     def scipy_events(self):
         """Terminal scipy event specs ``(index, kind, offset, scipy_direction)``.
 

@@ -1,0 +1,78 @@
+"""CasADi functions compiled to machine code (opt-in: ``SimulationOptions(native=True)``).
+
+CasADi generates C for a mode's normalised-time DAE (``CompiledMode.dae_tau``) with its Jacobian,
+and for its outputs; the system C compiler builds shared libraries that ``casadi.external``
+loads. IDAS then integrates the same equations, with the right-hand side and Jacobian evaluated
+as compiled code instead of CasADi's SX virtual machine: the same steps and results (bao2020:
+2012 steps, lock-up time equal to 12 digits), the run 15 ms instead of 22 ms. Compiling costs
+0.2-0.5 s per function; the libraries are kept in a cache directory under the system temporary
+directory, named by the hash of their source, so a later process with the same model loads them
+without compiling.
+"""
+
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import casadi as ca
+
+CACHE_DIR = Path(tempfile.gettempdir()) / "clutchocp-native"
+FLAGS = ("-O1", "-fPIC", "-shared")
+
+
+def compiler():
+    """Path of the C compiler ($CC, else cc or gcc), or None."""
+    for name in (os.environ.get("CC"), "cc", "gcc"):
+        if name and shutil.which(name):
+            return shutil.which(name)
+    return None
+
+
+def compile_function(function, with_jacobian=False):
+    """``function`` as an external Function built from generated C (None if that fails).
+
+    Parameters
+    ----------
+    function : casadi.Function
+        The function to compile; its name is the symbol looked up in the library.
+    with_jacobian : bool
+        Also compile its Jacobian (``jac_<name>``), which CasADi then uses for derivatives
+        (IDAS's Newton matrix).
+    """
+    cc = compiler()
+    if cc is None:
+        return None
+    name = function.name()
+    with tempfile.TemporaryDirectory() as work:
+        generator = ca.CodeGenerator(f"{name}.c", {"with_header": False})
+        generator.add(function)
+        if with_jacobian:
+            generator.add(function.jacobian())
+        generator.generate(work + os.sep)
+        source = Path(work, f"{name}.c")
+        digest = hashlib.sha1(source.read_bytes() + " ".join(FLAGS).encode()).hexdigest()[:16]
+        library = CACHE_DIR / f"{name}_{digest}.so"
+        if not library.is_file():
+            CACHE_DIR.mkdir(parents=True, exist_ok=True)
+            partial = CACHE_DIR / f"{name}_{digest}.{os.getpid()}.tmp"
+            built = subprocess.run([cc, *FLAGS, str(source), "-o", str(partial)], capture_output=True, check=False)
+            if built.returncode != 0:
+                partial.unlink(missing_ok=True)
+                return None
+            partial.replace(library)                  # atomic: concurrent processes never see half a file
+    return ca.external(name, str(library))
+
+
+def native_dae(cm):
+    """The normalised-time DAE of compiled mode ``cm``, compiled with its Jacobian (or None).
+
+    An external with the integrator's inputs (t, x, z, p, u) and outputs (ode, alg, quad, zero).
+    """
+    d = cm.dae_tau
+    empty = ca.SX(0, 1)
+    dae = ca.Function(f"{cm.name}_dae", [d["t"], d["x"], d["z"], d["p"], empty], [d["ode"], d["alg"], empty, empty],
+                      ca.dyn_in(), ca.dyn_out())
+    return compile_function(dae, with_jacobian=True)

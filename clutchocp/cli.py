@@ -49,7 +49,7 @@ def _cmd_simulate(args):
 
     overrides = dict(parse_override(text) for text in args.set)
     scene = load_scene(args.scene, overrides=overrides)
-    run = simulate_engagement(scene, rtol=args.rtol, atol=args.atol, method=args.method)
+    run = simulate_engagement(scene, rtol=args.rtol, atol=args.atol, method=args.method, native=args.native)
     print(format_summary(run.summary))
     files = write_engagement(run, args.out)
     print(f"wrote {len(files)} files to {args.out}: {', '.join(f.name for f in files)}")
@@ -85,6 +85,8 @@ def build_parser():
     p.add_argument("--atol", type=float, default=None, help="absolute tolerance on scaled states")
     p.add_argument("--method", default="idas", choices=("idas", "Radau", "BDF", "LSODA"),
                    help="integrator (default: idas)")
+    p.add_argument("--native", action="store_true",
+                   help="compile the equations to C with the system compiler first (faster repeated runs)")
     p.set_defaults(run=_cmd_simulate)
     p = sub.add_parser("control", help="hydro-viscous drive: operating points, linearisation, speed controller, closed loop")
     p.add_argument("scene", help="an hvd scene (e.g. liao2021_hvd, cui2019_hvd) or TOML file")

@@ -8,7 +8,7 @@ import numpy as np
 from ..errors import SceneError
 
 
-def _read_table(path, field):
+def read_table(path, field):
     """Read a two-column CSV (x, y) with an optional header; x must increase."""
     rows = []
     with open(path, newline="", encoding="utf-8") as handle:
@@ -45,7 +45,7 @@ class Actuation:
         self.ramp_time = scene.get("actuation.ramp_time")
         self.table = None
         if self.variant == "table":
-            self.table = _read_table(scene.value("actuation.file"), "actuation.file")
+            self.table = read_table(scene.value("actuation.file"), "actuation.file")
         self.has_state = self.variant == "valve_lag"
 
     def command(self, t):

@@ -22,11 +22,11 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
-from ..simulation.model import Event, HybridModel, Mode
-from .actuation import Actuation
+from ..simulation.model import Event, HybridModel, Mode, time_derivative
+from .actuation import Actuation, read_table
 from .films import FilmLaw
 
-ENERGY_TERMS = ("E_source", "E_hydraulic", "E_load", "E_slip", "E_film", "E_contact", "E_seal", "E_spline",
+ENERGY_TERMS = ("E_source", "E_hydraulic", "E_load", "E_slip", "E_film", "E_contact", "E_seal", "E_spline", "E_shaft",
                 "E_impact")
 ROTATIONS = ("slip_forward", "slip_reverse", "locked")
 
@@ -49,9 +49,18 @@ class EngagementModel:
     def __init__(self, scene, smooth=False, pressure_command=None):
         if scene.kind != "engagement":
             raise ModelError(f"scene '{scene.name}' is a {scene.kind} scene; an engagement needs kind = 'engagement'")
-        if scene.get("driveline.shaft_stiffness") is not None:
-            raise ModelError("driveline.shaft_stiffness: a compliant output shaft is not supported by the "
-                             "engagement model yet; remove the key to treat the shaft as rigid")
+        self.shaft_stiffness = scene.get("driveline.shaft_stiffness")
+        self.compliant = self.shaft_stiffness is not None
+        if self.compliant and scene.value("driveline.shaft_damping") <= 0:
+            raise ModelError("driveline.shaft_damping: must be > 0 with a compliant output shaft (the clutch hub "
+                             "between clutch and shaft is massless, so its speed is set by the damping)")
+        # Speed of the massless clutch hub at the shaft end: an algebraic variable while slipping.
+        self.w_hub = ca.SX.sym("w_hub") if self.compliant else None
+        self.load_table = None
+        if scene.variant("load") == "table":
+            data = read_table(scene.value("load.file"), "load.file")
+            self.load_table = ca.interpolant("load_table", "linear", [data[:, 0]], data[:, 1])
+            self.load_range = (float(data[0, 0]), float(data[-1, 0]))
         self.scene = scene
         self.film = FilmLaw(scene, smooth=smooth)
         self.actuation = Actuation(scene, command=pressure_command)
@@ -103,6 +112,9 @@ class EngagementModel:
             add("w_in", w_scale, s.value("driveline.input_speed"))
         if self.output_inertia:
             add("w_out", w_scale, s.value("driveline.output_speed"))
+        if self.compliant:
+            torque_scale = max(abs(s.value("driveline.input_torque")), 10.0)
+            add("theta_shaft", torque_scale / self.shaft_stiffness, 0.0)
         for name in ENERGY_TERMS:
             add(name, 1.0, 0.0)
         self.state_names = tuple(names)
@@ -138,7 +150,8 @@ class EngagementModel:
         if model == "quadratic":
             k = self.scene.value("load.rated_torque") / self.scene.value("load.rated_speed") ** 2
             return k * w_out * ca.fabs(w_out)
-        raise ModelError("load.model = 'table' is not supported by the engagement model yet")
+        lo, hi = self.load_range      # table of torque against speed, held constant beyond its ends
+        return self.load_table(ca.fmin(ca.fmax(w_out, lo), hi))
 
     def pressure(self):
         p_state = self.state("p_valve") if self.actuation.has_state else None
@@ -200,9 +213,10 @@ class EngagementModel:
         out = {}
         p = self.pressure()
         w_in, w_out = self.speeds()
-        w_rel = w_in - w_out
+        w_clutch = self.clutch_side_speed(rotation)
+        w_rel = w_in - w_clutch
         h = [self.state(f"h_{i + 1}") for i in range(n)]
-        K, S = zip(*(film.load_coefficients(hi, w_in, w_out) for hi in h))
+        K, S = zip(*(film.load_coefficients(hi, w_in, w_clutch) for hi in h))
         direction = {"slip_forward": 1.0, "slip_reverse": -1.0, "locked": 0.0}[rotation]
         T_visc = [film.viscous_torque(hi, w_rel) for hi in h]
         T_cont = [film.contact_torque(hi, w_rel, direction) for hi in h]
@@ -270,7 +284,20 @@ class EngagementModel:
         T_load = self.load_torque(w_out) if self.output_inertia else 0.0
         I_in = s.get("driveline.input_inertia")
         I_out = s.get("driveline.output_inertia")
-        if rotation == "locked":
+        alg, shaft_power = [], 0.0
+        if self.compliant:
+            c_shaft = s.value("driveline.shaft_damping")
+            T_shaft = self.shaft_stiffness * self.state("theta_shaft") + c_shaft * (w_clutch - w_out)
+            rate["theta_shaft"] = w_clutch - w_out
+            shaft_power = c_shaft * (w_clutch - w_out) ** 2
+            if rotation == "locked":
+                T_clutch = T_shaft                         # hub locked to the input
+            else:
+                T_clutch = sum(T_film)
+                alg = [T_clutch - T_shaft]                 # torque balance of the massless hub
+            a_in = (T_in - T_clutch) / I_in if self.input_inertia else 0.0
+            a_out = (T_shaft - T_load) / I_out if self.output_inertia else 0.0
+        elif rotation == "locked":
             if self.input_inertia and self.output_inertia:
                 w_dot = (T_in - T_load) / (I_in + I_out)
                 T_clutch = T_load + I_out * w_dot          # torque the locked clutch carries
@@ -301,18 +328,24 @@ class EngagementModel:
         rate["E_contact"] = contact_power
         rate["E_seal"] = seal_power
         rate["E_spline"] = spline_power
+        rate["E_shaft"] = shaft_power
         rate["E_impact"] = 0.0
         ode = ca.vertcat(*[rate[name] for name in self.state_names])
 
         # Outputs ------------------------------------------------------------------------------
-        a_out_expr = ca.SX(a_out) if not isinstance(a_out, ca.SX) else a_out
-        jerk = ca.jtimes(a_out_expr, self.x, ode) + ca.jacobian(a_out_expr, self.t)
+        x_dict = {name: self.state(name) for name in self.state_names}
+        z_dict = {"w_hub": self.w_hub} if alg else None
+        jerk = time_derivative(ca.SX(a_out), x_dict, [rate[name] for name in self.state_names],
+                               z=z_dict, alg=alg or None, t=self.t)
         out["pressure_Pa"] = p
         for i in range(n):
             out[f"h_{i + 1}_m"] = h[i]
         out.update(self._positions(h))
         out["w_in_rad_s"] = w_in
         out["w_out_rad_s"] = w_out
+        if self.compliant:
+            out["w_hub_rad_s"] = w_clutch
+            out["shaft_torque_Nm"] = T_shaft
         out["viscous_torque_Nm"] = sum(T_visc) if rotation != "locked" else 0.0
         out["contact_torque_Nm"] = sum(T_cont) if rotation != "locked" else T_clutch
         out["total_torque_Nm"] = T_clutch
@@ -321,20 +354,36 @@ class EngagementModel:
         out["pack_force_N"] = face_force
         out["output_acceleration_rad_s2"] = a_out
         out["output_jerk_rad_s3"] = jerk
-        out["dissipated_power_W"] = rate["E_slip"] + film_fluid_power + seal_power + spline_power
+        out["dissipated_power_W"] = rate["E_slip"] + film_fluid_power + seal_power + spline_power + shaft_power
         out["kinetic_energy_J"] = self._kinetic_energy()
         out["spring_energy_J"] = self.spring_energy(x0) if self.has_piston else 0.0
+        if self.compliant:
+            out["spring_energy_J"] += 0.5 * self.shaft_stiffness * self.state("theta_shaft") ** 2
 
         events = self._events(axial, rotation, direction, w_rel, capacity)
-        x_dict = {name: self.state(name) for name in self.state_names}
+        torque_scale = max(abs(s.value("driveline.input_torque")), 10.0)
+        w_scale = max(s.value("driveline.input_speed"), s.value("driveline.output_speed"), 1.0)
         return Mode(f"{axial}_{rotation}", x_dict, [rate[name] for name in self.state_names],
-                    outputs=out, events=events, x_nominal=dict(zip(self.state_names, self.nominal)))
+                    z=z_dict, alg=alg, outputs=out, events=events,
+                    x_nominal=dict(zip(self.state_names, self.nominal)),
+                    z_nominal={"w_hub": w_scale} if alg else None, alg_nominal=[torque_scale] if alg else None,
+                    z_guess={"w_hub": s.value("driveline.output_speed")} if alg else None)
+
+    def clutch_side_speed(self, rotation):
+        """Speed of the clutch plates on the output side [rad/s]: the output speed, or with a
+        compliant shaft the hub speed (algebraic while slipping, the input speed when locked)."""
+        w_in, w_out = self.speeds()
+        if not self.compliant:
+            return w_out
+        return w_in if rotation == "locked" else self.w_hub
 
     def locked_torque(self):
         """Torque the clutch must carry to keep both sides locked [N m], from the current state."""
         s = self.scene
         w_in, w_out = self.speeds()
         T_in = s.value("driveline.input_torque") if self.input_inertia else 0.0
+        if self.compliant:     # locked hub: the clutch carries the shaft torque
+            return self.shaft_stiffness * self.state("theta_shaft") + s.value("driveline.shaft_damping") * (w_in - w_out)
         if self.input_inertia and self.output_inertia:
             T_load = self.load_torque(w_out)
             I_in, I_out = s.value("driveline.input_inertia"), s.value("driveline.output_inertia")
@@ -374,6 +423,8 @@ class EngagementModel:
 
     def _lock_reset(self):
         """Equal speeds at lock-up (they already agree to the event tolerance)."""
+        if self.compliant:          # the hub locks to the input; the shaft keeps its twist
+            return None
         if self.input_inertia and self.output_inertia:
             return {"w_out": self.state("w_in")}
         if self.output_inertia:

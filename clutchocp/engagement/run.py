@@ -115,13 +115,14 @@ def energy_balance(model, result):
     """Energy bookkeeping of the run [J] and its relative error.
 
     work in (source + hydraulic - load + spring released) = kinetic energy change + contact
-    (elastic) storage + dissipation (slip, film, seal, splines, impact).
+    (elastic) storage + dissipation (slip, film, seal, splines, shaft damping, impact); the spring
+    energy includes the twist of a compliant shaft.
     """
     E = {name: result.final(name) for name in ENERGY_TERMS}
     ke = result["kinetic_energy_J"]
     spring = result["spring_energy_J"]
     work_in = E["E_source"] + E["E_hydraulic"] - E["E_load"] + (spring[0] - spring[-1])
-    dissipated = E["E_slip"] + E["E_film"] + E["E_seal"] + E["E_spline"] + E["E_impact"]
+    dissipated = E["E_slip"] + E["E_film"] + E["E_seal"] + E["E_spline"] + E["E_shaft"] + E["E_impact"]
     stored = (ke[-1] - ke[0]) + E["E_contact"]
     scale = max(abs(work_in), abs(ke[-1] - ke[0]), abs(dissipated), 1e-12)
     return {

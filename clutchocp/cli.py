@@ -7,7 +7,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from .errors import ClutchocpError
+import numpy as np
+
+from .errors import ClutchocpError, ModelError
 
 
 def _cmd_scenes(args):
@@ -63,6 +65,42 @@ def _cmd_control(args):
     return 0
 
 
+def _parse_weights(text):
+    """``"jerk=1,energy=0.1"`` -> {"jerk": 1.0, "energy": 0.1}."""
+    weights = {}
+    for item in filter(None, (part.strip() for part in text.split(","))):
+        name, eq, value = item.partition("=")
+        try:
+            weights[name.strip()] = float(value)
+        except ValueError:
+            eq = ""
+        if not eq:
+            raise ModelError(f"--weights {text}: write name=number pairs separated by commas, e.g. jerk=1,energy=0.1")
+    return weights
+
+
+def _parse_sweep(text):
+    """``"0.2,0.3,0.4"`` or ``"0.2:0.5:7"`` (start:stop:count) -> list of engagement-time limits [s]."""
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            return [float(v) for v in np.linspace(float(start), float(stop), int(count))]
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ModelError(f"--sweep-t-max {text}: give limits in seconds, '0.2,0.3,0.4' or start:stop:count "
+                         "like '0.2:0.5:7'") from None
+
+
+def _cmd_optimize(args):
+    from .optimal.report import run_optimize
+
+    run_optimize(args.scene, out_dir=args.out, t_max=args.t_max,
+                 weights=_parse_weights(args.weights) if args.weights else None,
+                 intervals=args.intervals, degree=args.degree,
+                 sweep_t_max=_parse_sweep(args.sweep_t_max) if args.sweep_t_max else None)
+    return 0
+
+
 def build_parser():
     """The argument parser of the ``clutchocp`` command."""
     parser = argparse.ArgumentParser(
@@ -88,6 +126,17 @@ def build_parser():
     p.add_argument("--native", action="store_true",
                    help="compile the equations to C with the system compiler first (faster repeated runs)")
     p.set_defaults(run=_cmd_simulate)
+    p = sub.add_parser("optimize", help="optimal engagement pressure by direct collocation (the main job)")
+    p.add_argument("scene", nargs="?", default=None, help="engagement scene (default: the default scene)")
+    p.add_argument("--out", default="out/optimize", help="output folder (default: out/optimize)")
+    p.add_argument("--t-max", type=float, default=None, help="largest engagement time [s]")
+    p.add_argument("--weights", default=None, metavar="NAME=W,...",
+                   help="objective weights, e.g. jerk=1,energy=0.1,time=0,jump=1")
+    p.add_argument("--intervals", type=int, default=100, help="collocation intervals (default: 100)")
+    p.add_argument("--degree", type=int, default=3, help="collocation points per interval (default: 3)")
+    p.add_argument("--sweep-t-max", default=None, metavar="LIST|START:STOP:COUNT",
+                   help="solve for several engagement-time limits and draw the jerk/time trade-off")
+    p.set_defaults(run=_cmd_optimize)
     p = sub.add_parser("control", help="hydro-viscous drive: operating points, linearisation, speed controller, closed loop")
     p.add_argument("scene", help="an hvd scene (e.g. liao2021_hvd, cui2019_hvd) or TOML file")
     p.add_argument("--controller", default=None, help="controller spec name (lqi, pi) or TOML file (default: lqi)")

@@ -1,0 +1,95 @@
+"""Verification of an optimum by IDAS, and the numbers of an IDAS engagement run.
+
+The optimal command is replayed on the exact (non-smoothed) model with IDAS and its lock-up
+events; just after the collocation lock time the command steps to the holding pressure (the larger
+of the last command and the scene's set pressure), as a transmission controller clamps a locked
+clutch. The collocation prediction and the IDAS run are then compared side by side.
+"""
+
+import numpy as np
+
+from ..simulation import SimulationOptions
+from .guess import DISSIPATED, slip_samples
+from .replay import CommandModel, simulate_command
+
+LOCK_TIME_TOLERANCE = 0.01      # relative
+JUMP_TOLERANCE = 0.02           # relative to the torque carried after lock-up
+HOLD_DELAY = 1e-3               # the holding command starts at (1 + HOLD_DELAY) t_f
+
+
+def run_numbers(run):
+    """Engagement numbers of an IDAS run over its slip phase (JSON-ready, None if it never locks).
+
+    Returns
+    -------
+    dict
+        engagement_time_s, lockup_torque_jump_Nm, jerk_integral (int jerk^2 dt over the slip phase
+        [rad^2/s^5], trapezoidal on the output samples), peak_jerk_rad_s3, peak_torque_Nm,
+        dissipated_energy_J (at lock-up), locked_torque_Nm.
+    """
+    summary = run.summary
+    out = {"engagement_time_s": summary["engagement_time_s"], "lockup_torque_jump_Nm": summary["lockup_torque_jump_Nm"],
+           "jerk_integral": None, "peak_jerk_rad_s3": None, "peak_torque_Nm": summary["peak_torque_Nm"],
+           "dissipated_energy_J": summary["dissipated_energy_J"], "locked_torque_Nm": None}
+    if summary["engagement_time_s"] is None:
+        return out
+    t, idx, _ = slip_samples(run)
+    jerk = run.result["output_jerk_rad_s3"][idx]
+    out["jerk_integral"] = float(np.trapezoid(jerk**2, t))
+    out["peak_jerk_rad_s3"] = float(np.max(np.abs(jerk)))
+    out["peak_torque_Nm"] = float(np.max(np.abs(run.result["total_torque_Nm"][idx])))
+    lock = next(e for e in run.result.events if e.name == "lockup" and e.target.endswith("locked"))
+    out["dissipated_energy_J"] = float(sum(lock.x_before[name] for name in DISSIPATED if name in lock.x_before))
+    out["locked_torque_Nm"] = float(lock.outputs_after["total_torque_Nm"])
+    return out
+
+
+def holding_pressure(ocp, opt):
+    """Command after lock-up [Pa]: the larger of the last command and the scene's set pressure."""
+    return float(max(opt.command[-1], ocp.scene.value("actuation.pressure")))
+
+
+def verify(ocp, opt, *, model=None, rtol=None, atol=None):
+    """Replay an optimum with IDAS and compare it with the collocation prediction.
+
+    Parameters
+    ----------
+    ocp : clutchocp.optimal.problem.EngagementOCP
+    opt : clutchocp.optimal.problem.OptimalEngagement
+    model : clutchocp.optimal.replay.CommandModel, optional
+        A command model of the scene already built (same control kind).
+    rtol, atol : float, optional
+        IDAS tolerances (default: the scene's).
+
+    Returns
+    -------
+    (dict, clutchocp.engagement.run.EngagementResult)
+        The comparison (JSON-ready) and the IDAS run.
+    """
+    model = model or CommandModel(ocp.scene, opt.control)
+    t_f = opt.t_f
+    # The hold starts a little after t_f: a lock-up located exactly on an input break (IDAS finds it
+    # at t_f within the event tolerance) made the engine skip that break and keep the last ramp.
+    hold = (t_f * (1 + HOLD_DELAY), holding_pressure(ocp, opt))
+    dense = np.linspace(0.0, t_f, 20 * ocp.transcription.intervals + 1)
+    near_lock = np.linspace(0.97 * t_f, 1.03 * t_f, 301)
+    run = simulate_command(ocp.scene, opt.command_times, opt.command, 1.5 * t_f, hold=hold, model=model,
+                           control=opt.control, points=301, extra_times=np.concatenate([dense, near_lock]),
+                           rtol=rtol, atol=atol)
+    idas = run_numbers(run)
+    colloc = {k: opt.terms[k] for k in ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral",
+                                        "peak_jerk_rad_s3", "peak_torque_Nm", "dissipated_energy_J",
+                                        "locked_torque_Nm")}
+    # IDAS locates lock-up to |w_rel| / w_scale <= event_value_tol; at the final slip rate that is:
+    w_scale = max(ocp.scene.value("driveline.input_speed"), 1.0)
+    rate = abs(opt.outputs["slip_acceleration_rad_s2"][-1])
+    resolution = SimulationOptions().event_value_tol * w_scale / rate if rate > 0 else None
+    out = {"collocation": colloc, "idas": idas, "holding_pressure_Pa": hold[1], "lock_time_resolution_s": resolution,
+           "lock_time_rel_diff": None, "torque_jump_Nm": idas["lockup_torque_jump_Nm"],
+           "torque_jump_rel": None, "passed": False}
+    if idas["engagement_time_s"] is not None:
+        out["lock_time_rel_diff"] = abs(idas["engagement_time_s"] - t_f) / t_f
+        out["torque_jump_rel"] = abs(idas["lockup_torque_jump_Nm"]) / max(abs(idas["locked_torque_Nm"]), 1e-9)
+        out["passed"] = bool(out["lock_time_rel_diff"] <= LOCK_TIME_TOLERANCE
+                             and out["torque_jump_rel"] <= JUMP_TOLERANCE)
+    return out, run

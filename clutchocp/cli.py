@@ -101,6 +101,14 @@ def _cmd_optimize(args):
     return 0
 
 
+def _cmd_bench(args):
+    from .bench import format_summary, run_bench
+
+    summary = run_bench(Path(args.out), quick=args.quick, progress=True)
+    print(format_summary(summary))
+    return 0
+
+
 def build_parser():
     """The argument parser of the ``clutchocp`` command."""
     parser = argparse.ArgumentParser(
@@ -137,6 +145,10 @@ def build_parser():
     p.add_argument("--sweep-t-max", default=None, metavar="LIST|START:STOP:COUNT",
                    help="solve for several engagement-time limits and draw the jerk/time trade-off")
     p.set_defaults(run=_cmd_optimize)
+    p = sub.add_parser("bench", help="error against run time, stiffness and scaling (work-precision report)")
+    p.add_argument("--quick", action="store_true", help="fewer tolerances and sizes (under 3 minutes)")
+    p.add_argument("--out", default="out/bench", help="output folder (default: out/bench)")
+    p.set_defaults(run=_cmd_bench)
     p = sub.add_parser("control", help="hydro-viscous drive: operating points, linearisation, speed controller, closed loop")
     p.add_argument("scene", help="an hvd scene (e.g. liao2021_hvd, cui2019_hvd) or TOML file")
     p.add_argument("--controller", default=None, help="controller spec name (lqi, pi) or TOML file (default: lqi)")

@@ -364,3 +364,16 @@ def test_chunked_integration_gives_the_same_answer():
     assert abs(runs[1].events[0].t - whole.events[0].t) <= 1e-8
     assert np.nanmax(np.abs(runs[1]["w2"] - whole["w2"])) <= 1e-7
     assert runs[1].stats["n_integrator_calls"] < runs[0].stats["n_integrator_calls"] / 2
+
+
+def test_input_break_at_the_instant_of_an_event_is_applied():
+    """x' = 1 until x = 1 - 1e-12 (an event 1e-12 s before the break); then x' = u, where u steps
+    from 0 to 2 at t = 1. The break must still apply (it was skipped: x stayed at 1)."""
+    x, u, t = ca.SX.sym("x"), ca.SX.sym("u"), ca.SX.sym("t")
+    rise = Mode("rise", {"x": x}, [ca.SX(1.0)], events=[Event("full", 1 - 1e-12 - x, "driven", direction=-1)])
+    driven = Mode("driven", {"x": x}, [u])
+    model = HybridModel([rise, driven], u={"u": u}, t=t)
+    grid = np.linspace(0.0, 2.0, 5)                        # t = 1 is a grid point and the break
+    res = simulate(model, {"x": 0.0}, grid, u={"u": PiecewiseConstant([1.0], [0.0, 2.0])})
+    assert res.event_times("full") == pytest.approx([1.0], abs=1e-9)
+    assert res.final("x") == pytest.approx(3.0, rel=1e-9)   # 1 + 2 (2 - 1)

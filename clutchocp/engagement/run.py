@@ -5,6 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import SolverError
 from ..simulation import SimulationOptions, simulate
 from .model import ENERGY_TERMS, EngagementModel
 
@@ -31,7 +32,7 @@ class EngagementResult:
 
 
 def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=None, output_points=None,
-                        model=None, native=False):
+                        model=None, native=False, solver_options=None):
     """Simulate an engagement scene through impact, slip and lock-up.
 
     Parameters
@@ -42,8 +43,9 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
         Integration tolerances (default: the scene's [simulation] values); ``atol`` applies to
         states scaled by their nominal values.
     method : str
-        ``"idas"`` (default) or a scipy method (``"Radau"``, ``"BDF"``, ``"LSODA"``) on the same
-        CasADi-generated right-hand side and Jacobian.
+        ``"idas"`` (default), ``"cvodes"`` (CasADi CVODES on the same equations; scenes whose
+        modes have no algebraic variables) or a scipy method (``"Radau"``, ``"BDF"``,
+        ``"LSODA"``) on the same CasADi-generated right-hand side and Jacobian.
     t_end : float, optional
         End time [s] (default: simulation.t_end).
     output_points : int, optional
@@ -55,6 +57,9 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
         IDAS: evaluate the equations and outputs as compiled machine code
         (:class:`~clutchocp.simulation.SimulationOptions` ``native``; same results, ~30 % faster
         runs, ~0.3 s of compilation per mode the first time).
+    solver_options : dict, optional
+        Further :class:`~clutchocp.simulation.SimulationOptions` fields, e.g.
+        ``{"max_wall_time": 10.0}`` (a wall-time cap [s]) or ``{"event_value_tol": 1e-10}``.
 
     Returns
     -------
@@ -66,16 +71,57 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     # IDAS calls end just past the predicted next event (simulation/idas_path.py): the free piston
     # of the approach phase is not integrated past its impact (bao2020: 2 000 steps in all; fixed
     # chunks of 32 intervals took 3 600, one call per piece 72 000).
-    options = SimulationOptions(rtol=rtol or scene.value("simulation.rtol"),
-                                atol=atol or scene.value("simulation.atol"), native=native)
+    settings = {"rtol": rtol or scene.value("simulation.rtol"), "atol": atol or scene.value("simulation.atol"),
+                "native": native}
+    settings.update(solver_options or {})
+    options = SimulationOptions(**settings)
     grid = np.unique(np.concatenate([np.linspace(0.0, t_end, n_out),
                                      [b for b in model.actuation.breakpoints() if b < t_end]]))
     x0 = dict(zip(model.state_names, model.initial_state))
     start = time.perf_counter()
-    result = simulate(model.hybrid, x0, grid, mode=model.initial_mode(), options=options, method=method)
+    try:
+        result = simulate(model.hybrid, x0, grid, mode=model.initial_mode(), options=options, method=method)
+    except SolverError as err:
+        raise explain_failure(model, err) from None
     wall = time.perf_counter() - start
     summary = summarize(model, result, wall, options, method)
     return EngagementResult(model, result, summary)
+
+
+def explain_failure(model, err):
+    """The solver error ``err`` with the engagement behind it, where it can be told from the state.
+
+    A film that has closed to (almost) zero thickness is the usual cause: with no asperity contact
+    to carry the load (contact.model = 'none', or roughness far smaller than the gap scale) the
+    squeeze film thins without bound, and through a permeable lining it drains completely in
+    finite time; the viscous torque ~ 1/h then overflows. Other errors are returned unchanged.
+    """
+    states = getattr(err, "states", None) or {}
+    gaps = {name: value for name, value in states.items() if name.startswith("h_")}
+    if not gaps:
+        return err
+    name, h = min(gaps.items(), key=lambda item: item[1])
+    sigma = model.film.sigma
+    if not (h <= 1e-3 * model.sigma):
+        return err
+    causes = []
+    if model.film.contact_model == "none":
+        causes.append("there is no asperity contact to carry the load (contact.model = 'none')")
+    elif sigma > 0 and sigma < 1e-3 * model.H0:
+        causes.append(f"the roughness roughness.sigma = {sigma:.3g} m is tiny against the gap "
+                      f"pack.initial_gap = {model.H0:.3g} m, so contact only begins at a vanishing film")
+    if model.film.permeability > 0:
+        causes.append(f"oil drains through the permeable lining (plates.lining_permeability = "
+                      f"{model.film.permeability:.3g} m^2) even when the film has closed")
+    why = "; ".join(causes) or "the film load could not stop the plates"
+    text = (f"{err} Extreme case: film {name} had closed to {h:.3g} m at t = {getattr(err, 't', float('nan')):.6g} s "
+            f"because {why}. Change: give a contact law with roughness (contact.model = 'greenwood_tripp', "
+            f"roughness.sigma of a few um), or plates.lining_permeability = 0, or a lower actuation.pressure.")
+    new = SolverError(text)
+    for attr in ("t", "mode", "flag", "states"):
+        if hasattr(err, attr):
+            setattr(new, attr, getattr(err, attr))
+    return new
 
 
 def _first_crossing(t, y, level):
@@ -140,14 +186,17 @@ def summarize(model, result, wall_time, options, method):
     locked_at_end = str(result.final_mode).endswith("locked")
     lock = locks[-1] if locks and locked_at_end else None
     jump = None
+    t_lock = float(lock.t) if lock is not None else None
     if lock is not None:
         jump = float(lock.outputs_after["total_torque_Nm"] - lock.outputs_before["total_torque_Nm"])
+    elif all(str(seg.mode).endswith("locked") for seg in result.segments):
+        t_lock = float(result.t[0])          # locked from the start (equal speeds held): no slip, no jump
     energy = energy_balance(model, result)
     pressure_time, torque_time = response_times(model, result)
     jerk = result["output_jerk_rad_s3"]
     return {
         "scene": model.scene.name,
-        "engagement_time_s": float(lock.t) if lock is not None else None,
+        "engagement_time_s": t_lock,
         "lockup_torque_jump_Nm": jump,
         "peak_torque_Nm": float(np.max(np.abs(result["total_torque_Nm"]))),
         "peak_jerk_rad_s3": float(np.max(np.abs(jerk[np.isfinite(jerk)]))),

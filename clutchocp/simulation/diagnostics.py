@@ -43,12 +43,16 @@ HINTS["scipy"] = ("the step size collapsed: the solution blows up or the model i
 HINTS["no_convergence"] = ("the algebraic equations could not be solved for z at this state",
                           ("give a better z guess (Mode z_guess), check the residual and z nominal scales, and "
                            "that d alg / d z is non-singular"))
+HINTS["wall_time"] = (("the wall-time limit (SimulationOptions.max_wall_time) was reached: the model is extremely "
+                       "stiff, badly scaled or switching modes very often here"),
+                      ("look at the states named here for a vanishing gap or a huge scale, loosen rtol/atol, or "
+                       "raise max_wall_time"))
 _DEFAULT = ("the integrator stopped", "tighten or loosen the tolerances, check the scales and the model")
 
 
 def idas_flag(message):
-    """The IDAS return flag named in a CasADi error message (or 'unknown')."""
-    found = re.search(r"(IDA_[A-Z_]+)", str(message))
+    """The IDAS (or CVODES) return flag named in a CasADi error message (or 'unknown')."""
+    found = re.search(r"((?:IDA|CV)_[A-Z_]+)", str(message))
     return found.group(1) if found else "unknown"
 
 
@@ -63,7 +67,7 @@ def largest_scaled(names, scaled, nominal, count=3):
 
 def solver_error(solver, flag, t, cm, xs, zs=None, detail=""):
     """Build a :class:`~clutchocp.errors.SolverError` for a failure at time ``t`` in mode ``cm``."""
-    why, remedy = HINTS.get(flag, _DEFAULT)
+    why, remedy = HINTS.get(flag) or HINTS.get(str(flag).replace("CV_", "IDA_", 1), _DEFAULT)
     where = f"Largest scaled states: {largest_scaled(cm.x_names, xs, cm.x_nominal)}"
     if zs is not None and cm.nz:
         where += f"; algebraic: {largest_scaled(cm.z_names, zs, cm.z_nominal)}"

@@ -5,6 +5,7 @@ import time
 import numpy as np
 
 from clutchocp.errors import ModelError, SolverError
+from clutchocp.simulation.diagnostics import solver_error
 from clutchocp.simulation.events import ARMED, PASSED, EventMonitor
 from clutchocp.simulation.idas_path import IdasPath
 from clutchocp.simulation.model import PiecewiseConstant
@@ -34,9 +35,10 @@ def simulate(model, x0, grid, *, mode=None, p=None, u=None, z_guess=None, method
         Value or schedule of every input.
     z_guess : mapping of str to float, optional
         Starting guess for the initial algebraic variables (default: the mode's z_guess).
-    method : {"idas", "Radau", "BDF", "LSODA"}
-        "idas" integrates the DAE with CasADi IDAS; the others integrate the ODE obtained by
-        eliminating z with scipy's ``solve_ivp`` (a cross-check path).
+    method : {"idas", "cvodes", "Radau", "BDF", "LSODA"}
+        "idas" integrates the DAE with CasADi IDAS; "cvodes" the same equations with CasADi
+        CVODES (modes without algebraic variables only); the others integrate the ODE obtained
+        by eliminating z with scipy's ``solve_ivp`` (a cross-check path).
     options : SimulationOptions, optional
         Tolerances and limits.
 
@@ -65,7 +67,8 @@ def simulate(model, x0, grid, *, mode=None, p=None, u=None, z_guess=None, method
     mode = model.initial_mode if mode is None else mode
     if mode not in compiled:
         raise ModelError(f"unknown initial mode '{mode}'; modes: {list(compiled)}")
-    run = _Run(compiled, grid, opts, _make_path(method, opts), _inputs(model, p, u, grid))
+    deadline = wall_start + opts.max_wall_time if opts.max_wall_time is not None else None
+    run = _Run(compiled, grid, opts, _make_path(method, opts, deadline), _inputs(model, p, u, grid))
     cm = compiled[mode]
     xs0 = _initial_state(cm, x0)
     guess = None
@@ -83,8 +86,10 @@ def simulate(model, x0, grid, *, mode=None, p=None, u=None, z_guess=None, method
     return SimulationResult.from_segments(run.segments(), run.events, stats)
 
 
-def _make_path(method, opts):
-    return IdasPath(opts) if method == "idas" else ScipyPath(method, opts)
+def _make_path(method, opts, deadline=None):
+    path = IdasPath(opts, plugin=method) if method in ("idas", "cvodes") else ScipyPath(method, opts)
+    path.deadline = deadline
+    return path
 
 
 def _initial_state(cm, x0):
@@ -242,6 +247,9 @@ class _Run:
     def loop(self):
         t_final = self.grid[-1]
         while self.t < t_final - self.tiny:
+            if self.path.deadline is not None and time.perf_counter() > self.path.deadline:
+                raise solver_error(self.path.name, "wall_time", self.t, self.cm, self.xs, self.zs,
+                                   detail=f" ({self.opts.max_wall_time:g} s)")
             t_end = next((b for b in self.inputs.breaks if b > self.t + self.tiny), t_final)
             inner = self.grid[(self.grid > self.t + self.tiny) & (self.grid < t_end - self.tiny)]
             times = np.append(inner, t_end)
@@ -268,10 +276,19 @@ class _Run:
             self._add(self.t, self.xs, self.zs, self.pu)
             self._switch(fired, crossing.iterations)
             self._enter()
+            self._break_at_event()
 
-    def _input_break(self):
-        """Inputs jump at self.t: new consistent z, a sample on each side, events re-armed."""
-        self.pu = self.inputs.at(self.t)
+    def _input_break(self, at=None):
+        """Inputs jump at self.t (their values taken at ``at``, default self.t): new consistent z,
+        a sample on each side, events re-armed."""
+        self.pu = self.inputs.at(self.t if at is None else at)
         self.zs = self.cm.consistent_z(self.xs, self.pu, self.t, self.zs)
         self._add(self.t, self.xs, self.zs, self.pu)
         self._enter()
+
+    def _break_at_event(self):
+        """An event located within ``tiny`` of an input break: the next piece starts past that
+        break, so apply it here (else the old input values would stay in force)."""
+        for b in self.inputs.breaks:
+            if abs(b - self.t) <= self.tiny and not np.array_equal(self.inputs.at(b), self.pu):
+                self._input_break(at=b)

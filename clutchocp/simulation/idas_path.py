@@ -40,15 +40,21 @@ gap below zero), so IDAS may fail there before the event has been seen. A failed
 retried on the first half of its output times (an event before the failure is then found on
 the grid); within a single interval the farthest reachable time is found by bisection and
 checked for a crossing. Only if none crossed is a SolverError raised.
+
+The same class drives CasADi's CVODES (``plugin="cvodes"``, ``method="cvodes"``) on the same
+normalised-time ODE for modes without algebraic variables, and enforces
+``SimulationOptions.max_wall_time`` before every call.
 """
 
 import math
+import time
 import warnings
 from collections import OrderedDict
 
 import casadi as ca
 import numpy as np
 
+from clutchocp.errors import ModelError
 from clutchocp.simulation.diagnostics import idas_flag, solver_error
 from clutchocp.simulation.events import ARMED, ENTRY, Advance, Crossing, locate
 
@@ -140,12 +146,21 @@ class _Integrator:
 
 
 class IdasPath:
-    """Integrates modes with IDAS; see the module docstring."""
+    """Integrates modes with IDAS; see the module docstring.
 
-    name = "idas"
+    ``plugin="cvodes"`` integrates the same normalised-time equations with CasADi's CVODES
+    (BDF, the ODE counterpart of IDAS) instead: for modes without algebraic variables only,
+    with no consistent initialisation needed; everything else (events, restarts, caching) is
+    shared. ``deadline`` (a ``time.perf_counter()`` value, set by the driver from
+    ``max_wall_time``) is checked before every integrator call.
+    """
 
-    def __init__(self, options):
+    def __init__(self, options, plugin="idas"):
+        if plugin not in ("idas", "cvodes"):
+            raise ModelError(f"IdasPath plugin must be 'idas' or 'cvodes', got {plugin!r}")
         self.options = options
+        self.plugin = self.name = plugin
+        self.deadline = None
         self.counters = {v: 0 for v in _COUNTERS.values()}
         self.counters.update(n_integrator_calls=0, n_location_integrations=0, n_probe_integrations=0,
                              n_integrators_built=0)
@@ -154,11 +169,15 @@ class IdasPath:
     # ------------------------------------------------------------------ IDAS calls
     def _idas_options(self, span):
         o = self.options
-        opts = {"abstol": o.atol, "reltol": o.rtol, "max_num_steps": o.max_num_steps,
-                "suppress_algebraic": o.suppress_algebraic, "calc_ic": True, "first_time": FIRST_TIME}
+        # NaN/Inf in an evaluation is reported by the integrator's flag (IDA_RES_FAIL, ...) and
+        # turned into a SolverError; CasADi's own per-evaluation warnings would flood stderr.
+        opts = {"abstol": o.atol, "reltol": o.rtol, "max_num_steps": o.max_num_steps, "show_eval_warnings": False}
+        if self.plugin == "idas":
+            opts.update(suppress_algebraic=o.suppress_algebraic, calc_ic=True, first_time=FIRST_TIME)
         if o.max_step is not None:
             opts["max_step_size"] = o.max_step / span          # normalised time
-        opts.update(o.idas_options)
+        if self.plugin == "idas":
+            opts.update(o.idas_options)
         return opts
 
     def _integrator(self, cm, taus, span):
@@ -167,11 +186,14 @@ class IdasPath:
         uniform = np.allclose(taus, np.arange(1, n + 1) / n, rtol=0, atol=1e-9)
         pattern = n if uniform else tuple(np.round(taus, 12))
         key = (self._options_key, pattern, span if self.options.max_step is not None else None)
-        cache = cm.integrators.setdefault("idas", OrderedDict())
+        cache = cm.integrators.setdefault(self.plugin, OrderedDict())
         entry = cache.get(key)
         if entry is None:
+            if self.plugin == "cvodes" and cm.nz:
+                raise ModelError(f"method 'cvodes' integrates ODEs only: mode '{cm.name}' has algebraic variables "
+                                 f"{cm.z_names}; use method='idas'")
             grid = [k / n for k in range(1, n + 1)] if uniform else [float(x) for x in taus]
-            entry = _Integrator(ca.integrator(f"idas_{cm.name}", "idas", self._dae(cm), 0.0, grid,
+            entry = _Integrator(ca.integrator(f"{self.plugin}_{cm.name}", self.plugin, self._dae(cm), 0.0, grid,
                                               self._idas_options(span)), cm.nx, cm.nz, n)
             self.counters["n_integrators_built"] += 1
             cache[key] = entry
@@ -207,6 +229,9 @@ class IdasPath:
 
     def _integrate(self, cm, t0, xs0, zs0, pu, times):
         """From ``t0`` over the output ``times``: scaled states (nx, n) and algebraic variables (nz, n)."""
+        if self.deadline is not None and time.perf_counter() > self.deadline:
+            raise solver_error(self.name.upper(), "wall_time", t0, cm, xs0, zs0,
+                               detail=f" ({self.options.max_wall_time:g} s)")
         times = np.asarray(times, float)
         span = float(times[-1] - t0)
         taus = (times - t0) / span
@@ -214,7 +239,7 @@ class IdasPath:
         try:
             return self._run(self._integrator(cm, taus, span), xs0, zs0, p)
         except _IdasFailure:
-            if cm.nz:
+            if cm.nz or self.plugin != "idas":
                 raise
         # an ODE mode: the consistent start derivative is f(x0); IDAS without IDACalcIC
         xdot = np.array(cm.f_ode(xs0, np.zeros(0), pu, t0), dtype=float).ravel() * span
@@ -276,7 +301,7 @@ class IdasPath:
                 crossing = self._locate(cm, pu, left, right, crossings)
                 return _advance(blocks, cm, crossing)
             if failure is not None:
-                raise solver_error("IDAS", failure.flag, targets[-1], cm, xs[:, -1], zs[:, -1])
+                raise solver_error(self.name.upper(), failure.flag, targets[-1], cm, xs[:, -1], zs[:, -1])
             left = _Point(targets[-1], xs[:, -1], zs[:, -1], s[:, -1])
             if t_probe is not None:
                 probes += 1
@@ -347,7 +372,7 @@ class IdasPath:
             if monitor.scan(left.s, self._events(cm, xs, zs, pu, mid)[:, 0])[0]:
                 break
         if best is None:
-            raise solver_error("IDAS", fail.flag, left.t, cm, left.xs, left.zs)
+            raise solver_error(self.name.upper(), fail.flag, left.t, cm, left.xs, left.zs)
         return np.array([best[0]]), best[1].reshape(cm.nx, 1), best[2].reshape(cm.nz, 1)
 
     @staticmethod

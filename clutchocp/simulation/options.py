@@ -4,7 +4,7 @@ from dataclasses import asdict, dataclass, field
 
 from clutchocp.errors import ModelError
 
-METHODS = ("idas", "Radau", "BDF", "LSODA")
+METHODS = ("idas", "cvodes", "Radau", "BDF", "LSODA")
 
 
 @dataclass
@@ -50,7 +50,12 @@ class SimulationOptions:
         right-hand side, 0.2-0.5 s of compilation per mode the first time. Without a C
         compiler the equations are evaluated as usual (with a warning).
     idas_options : dict
-        Extra options passed to ``casadi.integrator(..., "idas", ...)``.
+        Extra options passed to ``casadi.integrator(..., "idas", ...)`` (not to CVODES).
+    max_wall_time : float or None
+        Wall-time limit of one simulation [s] (None: none). Checked before every integrator
+        call (an IDAS or CVODES call is bounded by ``max_num_steps``) and in every right-hand
+        side evaluation of the scipy methods; when passed, a SolverError says when and where
+        the run stopped.
     """
 
     rtol: float = 1e-8
@@ -67,6 +72,7 @@ class SimulationOptions:
     chunk_growth: float | None = None
     native: bool = False
     idas_options: dict = field(default_factory=dict)
+    max_wall_time: float | None = None
 
     def __post_init__(self):
         for name in ("rtol", "atol", "event_time_tol", "event_value_tol", "event_band"):
@@ -76,6 +82,8 @@ class SimulationOptions:
         if self.event_band <= self.event_value_tol:
             raise ModelError("SimulationOptions.event_band must exceed event_value_tol "
                              f"({self.event_band} <= {self.event_value_tol})")
+        if self.max_wall_time is not None and not self.max_wall_time > 0:
+            raise ModelError(f"SimulationOptions.max_wall_time must be positive or None, got {self.max_wall_time!r}")
         if self.max_step is not None and not self.max_step > 0:
             raise ModelError(f"SimulationOptions.max_step must be positive or None, got {self.max_step!r}")
         if self.chunk is not None and not (isinstance(self.chunk, int) and self.chunk >= 1):

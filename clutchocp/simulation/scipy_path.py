@@ -11,6 +11,8 @@ CasADi's buffer interface (numpy in and out), so a benchmark against IDAS does n
 scipy methods for avoidable conversions.
 """
 
+import time
+
 import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -71,6 +73,7 @@ class ScipyPath:
         self.name = method
         self.method = method
         self.options = options
+        self.deadline = None          # time.perf_counter() limit (SimulationOptions.max_wall_time)
         self.counters = {"n_rhs_evals": 0, "n_jacobian_evals": 0, "n_lu_decompositions": 0,
                          "n_integrator_calls": 0}
 
@@ -80,12 +83,19 @@ class ScipyPath:
             red = cm.integrators["scipy_reduced"] = _Reduced(cm)
         guess = {"z": None}
 
+        empty = np.zeros(0)
+
         def z_of(t, xs):
+            if not cm.nz:
+                return empty
             if red.rootfinder is None:
                 return np.array(red.f_z(xs, pu, t), dtype=float).ravel()
             return np.array(cm.consistent_z(xs, pu, t, guess["z"]), dtype=float)
 
         def rhs(t, xs):
+            if self.deadline is not None and time.perf_counter() > self.deadline:
+                raise solver_error(f"scipy {self.method}", "wall_time", t, cm, xs,
+                                   detail=f" ({self.options.max_wall_time:g} s)")
             if red.rootfinder is None:
                 return red.rhs_buffered(xs, pu, t).ravel()
             zs = z_of(t, xs)

@@ -1,0 +1,193 @@
+"""``clutchocp bench``: work-precision, stiffness, pack-size scaling and optimisation convergence.
+
+:func:`run_bench` runs everything for every built-in engagement scene and writes into a folder:
+
+* ``engagement_work_precision.csv`` / ``.png`` -- every integrator over the tolerance sweep;
+* ``engagement_speedup.csv`` -- time ratio of each peer to IDAS at matched error levels;
+* ``stiffness_<scene>.csv`` / ``.png`` -- Jacobian eigenvalue spread and fastest time constant
+  along the reference trajectory;
+* ``scaling.csv`` / ``scaling.png`` -- run time against the number of plate pairs;
+* ``optimization_convergence.csv`` / ``.png`` -- collocation errors against solve time;
+* ``summary.json`` -- per scene ``speedup_vs_radau``, ``speedup_vs_bdf``, ``speedup_vs_lsoda``,
+  ``speedup_vs_cvodes`` (geometric mean over the matched error levels below 1e-4 that both
+  sweeps reach; ``*_min`` the smallest), ``scaling_exponent_pairs`` and the stiffness extremes;
+  the targets of issue 6 and whether they were met.
+
+``quick=True`` leaves out IDAS with native code, times single runs (three for the engine methods)
+and solves coarser optimisation meshes (about a minute on two cores).
+"""
+
+import math
+import time
+from pathlib import Path
+
+from ..engagement.model import EngagementModel
+from ..engagement.stiffness import stiffness_profile, write_stiffness
+from ..output import write_csv, write_summary
+from ..scene.loader import list_scenes
+from . import optimization, scaling, workprecision
+from .progress import Progress
+
+FULL = {"tolerances": workprecision.TOLERANCES, "methods": workprecision.METHODS, "repeats": 3,
+        "scaling_repeats": 3}
+QUICK = {"tolerances": workprecision.TOLERANCES, "methods": ("idas", "cvodes", "Radau", "BDF", "LSODA"),
+         "repeats": 1, "scaling_repeats": 1}
+SCALING_TARGET = 1.3        # issue 6: growth exponent of run time in plate pairs <= 1.3
+SPEED_TARGET_BELOW = 1e-4   # issue 6: IDAS ahead of every scipy method at every matched error below 1e-4
+
+
+def engagement_scenes():
+    """The built-in engagement scenes, by name."""
+    return [s for s in list_scenes() if s.kind == "engagement"]
+
+
+def _steps(settings, n_scenes, opt_steps):
+    per_scene = 1 + len(settings["methods"]) * len(settings["tolerances"]) + 1 + len(scaling.PAIRS)
+    return n_scenes * per_scene + opt_steps
+
+
+def run_bench(out_dir, quick=False, progress=True, scenes=None):
+    """Run the benchmark and write its files.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        Output folder (created).
+    quick : bool
+        No native-code IDAS, single timed runs (three for the engine methods), coarser
+        optimisation meshes.
+    progress : bool
+        One line per step on stderr.
+    scenes : sequence of Scene, optional
+        Default: every built-in engagement scene.
+
+    Returns
+    -------
+    dict
+        The summary also written to ``summary.json``.
+    """
+    start = time.perf_counter()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    settings = QUICK if quick else FULL
+    scenes = list(scenes) if scenes is not None else engagement_scenes()
+    opt_plan = optimization.plan(quick)
+    bar = Progress(_steps(settings, len(scenes), len(opt_plan["meshes"]) + 1 if opt_plan else 0), enabled=progress)
+    files, results, per_scene, scaling_results, speed_rows = [], [], {}, {}, []
+
+    for scene in scenes:
+        model = EngagementModel(scene)
+        res = workprecision.sweep(scene, methods=settings["methods"], tolerances=settings["tolerances"],
+                                  repeats=settings["repeats"], progress=bar, model=model)
+        results.append(res)
+        profile = stiffness_profile(res.pop("reference_run"))
+        files += write_stiffness(profile, out)
+        bar.step(f"{scene.name}: stiffness ratio up to {profile.summary()['max_stiffness_ratio']:.3g}")
+        scaling_results[scene.name] = scaling.plate_pair_scaling(scene, pairs=scaling.PAIRS,
+                                                                 repeats=settings["scaling_repeats"], progress=bar)
+        per_scene[scene.name] = _scene_summary(res, profile, scaling_results[scene.name], speed_rows)
+
+    files.append(workprecision.write_rows(out / "engagement_work_precision.csv", [r for res in results for r in res["rows"]]))
+    files.append(workprecision.plot_work_precision(results, out / "engagement_work_precision.png"))
+    files.append(write_csv(out / "engagement_speedup.csv", {
+        key: [row[key] for row in speed_rows] for key in ("scene", "peer", "error_level", "time_ratio_to_idas")}))
+    files.append(_write_scaling(scaling_results, out / "scaling.csv"))
+    files.append(scaling.plot_scaling(scaling_results, out / "scaling.png"))
+
+    opt_summary = optimization.convergence(out, quick=quick, progress=bar) if opt_plan else optimization.unavailable()
+    files += [Path(p) for p in opt_summary.pop("files", [])]
+
+    summary = {"quick": quick, "scenes": per_scene, "optimization": opt_summary,
+               "settings": {"tolerances": list(settings["tolerances"]), "methods": list(settings["methods"]),
+                            "repeats": settings["repeats"], "reference_rtol": workprecision.REFERENCE_RTOL,
+                            "atol_over_rtol": workprecision.ATOL_RATIO,
+                            "matched_error_levels": list(workprecision.ERROR_LEVELS)},
+               "targets": _targets(per_scene), "wall_time_s": time.perf_counter() - start}
+    files.append(write_summary(out / "summary.json", json_ready(summary)))
+    summary["files"] = [str(f) for f in files]
+    bar.note(f"done in {summary['wall_time_s']:.0f} s; wrote {len(files)} files to {out}")
+    return summary
+
+
+def json_ready(value):
+    """``value`` with every non-finite float replaced by None (summary.json holds no NaN or inf)."""
+    if isinstance(value, dict):
+        return {k: json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def _scene_summary(res, profile, scale, speed_rows):
+    """The summary.json entry of one scene (and its rows of the speed-up table)."""
+    entry = {"reference": res["reference"], "confirmation": res["confirmation"]}
+    for metric, key in (("wall", "wall_time_s"), ("cpu", "cpu_time_s")):
+        ratios = workprecision.speedups(res["rows"], key=key)
+        for peer, by_level in ratios.items():
+            mean, low, count = workprecision.headline(by_level)
+            name = f"speedup_vs_{peer.lower()}" + ("" if metric == "wall" else "_cpu")
+            entry[name] = mean
+            entry[f"{name}_min"] = low
+            entry[f"{name}_levels"] = count
+            if metric == "wall":
+                entry[f"{name}_by_error"] = {f"{lvl:.1e}": r for lvl, r in by_level.items() if r is not None}
+                speed_rows += [{"scene": res["scene"], "peer": peer, "error_level": lvl, "time_ratio_to_idas": r}
+                               for lvl, r in by_level.items() if r is not None]
+    entry["scaling_exponent_pairs"] = scale["exponent"]
+    entry["scaling_exponent_pairs_per_step"] = scale["exponent_per_step"]
+    entry["scaling"] = {k: scale[k] for k in ("pairs", "wall_time_s", "n_steps", "n_states", "engagement_time_s")}
+    entry["stiffness"] = profile.summary()
+    return entry
+
+
+def _targets(per_scene):
+    """Issue 6 targets, measured."""
+    misses = []
+    for name, entry in per_scene.items():
+        if entry["scaling_exponent_pairs"] > SCALING_TARGET:
+            misses.append(f"{name}: run time grows as pairs^{entry['scaling_exponent_pairs']:.2f} > {SCALING_TARGET}")
+        for peer in workprecision.SCIPY:
+            for level, ratio in entry[f"speedup_vs_{peer.lower()}_by_error"].items():
+                if float(level) < SPEED_TARGET_BELOW and ratio < 1.0:
+                    misses.append(f"{name}: {peer} faster than IDAS at error {level} (ratio {ratio:.2f})")
+    return {"scaling_exponent_max": SCALING_TARGET, "idas_ahead_of_scipy_below_error": SPEED_TARGET_BELOW,
+            "met": not misses, "misses": misses}
+
+
+def _write_scaling(results, path):
+    rows = [(name, n, t, s, k) for name, res in results.items()
+            for n, t, s, k in zip(res["pairs"], res["wall_time_s"], res["n_steps"], res["n_states"])]
+    return write_csv(path, {"scene": [r[0] for r in rows], "plate_pairs": [r[1] for r in rows],
+                            "wall_time_s": [r[2] for r in rows], "n_steps": [r[3] for r in rows],
+                            "n_states": [r[4] for r in rows]})
+
+
+def format_summary(summary):
+    """A few lines for the terminal: speed-ups at matched error, scaling, stiffness, targets."""
+    def num(value, fmt="{:.2f}"):
+        return "-" if value is None else fmt.format(value)
+
+    lines = [f"clutchocp bench ({'quick' if summary['quick'] else 'full'}): {summary['wall_time_s']:.0f} s"]
+    for name, e in summary["scenes"].items():
+        ratios = ", ".join(f"{peer} {num(e.get(f'speedup_vs_{peer}'))}x (min {num(e.get(f'speedup_vs_{peer}_min'))})"
+                           for peer in ("radau", "bdf", "lsoda", "cvodes"))
+        stiff = e["stiffness"]
+        lines.append(f"  {name}: IDAS vs {ratios}")
+        lines.append(f"    run time ~ pairs^{e['scaling_exponent_pairs']:.2f}; stiffness ratio up to "
+                     f"{num(stiff['max_stiffness_ratio'], '{:.3g}')}, fastest time constant "
+                     f"{num(stiff['min_time_constant_s'], '{:.3g}')} s")
+    opt = summary["optimization"]
+    if opt.get("available"):
+        ref = opt["reference"]
+        lines.append(f"  optimisation: reference N = {ref['intervals']}, degree {ref['degree']}; "
+                     + ", ".join(f"N={r['intervals']}/d={r['degree']} objective error "
+                                 f"{num(r.get('objective_rel_error'), '{:.1e}')} in {num(r.get('solve_time_s'))} s"
+                                 for r in opt["rows"] if r.get("status") == "ok"))
+    else:
+        lines.append(f"  optimisation: not run ({opt.get('reason')})")
+    targets = summary["targets"]
+    lines.append("  targets met" if targets["met"] else "  targets missed: " + "; ".join(targets["misses"]))
+    return "\n".join(lines)
+

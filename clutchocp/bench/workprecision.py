@@ -1,0 +1,299 @@
+"""Work-precision of the engagement simulation: error against run time for every integrator.
+
+Every method integrates the same CasADi-generated equations of a scene
+(:func:`clutchocp.engagement.run.simulate_engagement`): ``"idas"`` (the default engine),
+``"idas-native"`` (IDAS with the equations compiled to machine code), ``"cvodes"`` (CasADi's
+CVODES on the same normalised-time ODE; the engagement modes have no algebraic variables) and
+scipy's ``"Radau"``, ``"BDF"``, ``"LSODA"`` (the reduced ODE with the exact CasADi Jacobian).
+
+Error of a run against a reference (all relative, see :func:`trajectory_errors`): speeds on the
+output grid (to the largest reference speed), film thicknesses on the grid (to the local
+thickness, at least the roughness), lock-up time, lock-up torque jump; the run's error is the
+largest of the four. The reference is IDAS at ``REFERENCE_RTOL``, confirmed by scipy Radau at
+``CONFIRM_RTOL`` (the confirmation's own error against it is reported). The engine locates events
+to ``event_value_tol`` (1e-6 of the scaled event function) by default; so that the lock time
+measures the integrator and not that setting, the engine methods get event tolerances that
+follow the integration tolerance (:func:`event_options`), while scipy locates its events to
+machine precision on its dense output.
+
+Wall times are of the whole ``simulate_engagement`` call (integration, event location, outputs,
+summary) with the model built and its integrators cached by an untimed warm-up run; the best of
+``repeats`` runs counts. Times at matched error come from the Pareto front of each method's
+(error, time) points, interpolated in log-log (:func:`time_at_error`).
+"""
+
+import itertools
+import math
+import time
+
+import numpy as np
+
+from ..engagement.model import EngagementModel
+from ..engagement.run import simulate_engagement
+from ..errors import ClutchocpError, ModelError
+from ..output import new_figure, save_figure, write_csv
+
+METHODS = ("idas", "idas-native", "cvodes", "Radau", "BDF", "LSODA")
+SCIPY = ("Radau", "BDF", "LSODA")
+PEERS = ("cvodes", "Radau", "BDF", "LSODA")          # compared with idas at matched error
+TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
+REFERENCE_RTOL = 1e-12
+CONFIRM_METHOD, CONFIRM_RTOL = "Radau", 1e-10
+ATOL_RATIO = 1e-2                                      # atol = rtol * ATOL_RATIO (scaled states)
+ERROR_LEVELS = tuple(10.0 ** -k for k in np.arange(4.5, 10.01, 0.5))   # matched errors below 1e-4
+ERROR_PARTS = ("speeds", "gaps", "lock_time", "torque_jump")
+
+
+def event_options(rtol):
+    """Engine event tolerances for integration tolerance ``rtol``: the default ones (1e-9 s,
+    1e-6) at rtol >= 1e-6, tighter with tighter rtol, so the event location error stays below
+    the integration error."""
+    return {"event_value_tol": min(1e-6, rtol), "event_time_tol": min(1e-9, 1e-3 * rtol)}
+
+
+def run_method(scene, model, method, rtol, **solver_options):
+    """One engagement run with ``method`` at ``rtol`` (atol = rtol * ATOL_RATIO)."""
+    native = method == "idas-native"
+    engine = method in ("idas", "idas-native", "cvodes")
+    options = {**(event_options(rtol) if engine else {}), **solver_options}
+    return simulate_engagement(scene, model=model, method="idas" if native else method, rtol=rtol,
+                               atol=rtol * ATOL_RATIO, native=native, solver_options=options)
+
+
+def timed_run(scene, model, method, rtol, repeats=1, **solver_options):
+    """Best wall time [s], best CPU time [s] of ``repeats`` runs, and the last run."""
+    best_wall, best_cpu, run = math.inf, math.inf, None
+    for _ in range(max(1, repeats)):
+        wall, cpu = time.perf_counter(), time.process_time()
+        run = run_method(scene, model, method, rtol, **solver_options)
+        best_wall = min(best_wall, time.perf_counter() - wall)
+        best_cpu = min(best_cpu, time.process_time() - cpu)
+    return best_wall, best_cpu, run
+
+
+def grid_values(run, name):
+    """Values of ``name`` on the scene's output grid (of the samples repeating a time at an
+    event, the one after it)."""
+    scene = run.model.scene
+    grid = np.linspace(0.0, scene.value("simulation.t_end"), scene.value("simulation.output_points"))
+    t, values = run.result.t, run.result[name]
+    index = np.searchsorted(t, grid, side="right") - 1
+    return values[index]
+
+
+def _relative(value, reference, floor=0.0):
+    if value is None and reference is None:
+        return 0.0
+    if value is None or reference is None:
+        return math.inf
+    return abs(value - reference) / max(abs(reference), floor) if max(abs(reference), floor) > 0 else abs(value)
+
+
+def trajectory_errors(run, reference):
+    """Relative errors of ``run`` against ``reference`` (same scene and grid).
+
+    Returns
+    -------
+    dict
+        ``speeds``: max over the grid of |w - w_ref| / max |w_ref| (input and output);
+        ``gaps``: max over the grid and the films of |h - h_ref| / max(h_ref, sigma);
+        ``lock_time``: |t - t_ref| / t_ref (inf if only one of them locks);
+        ``torque_jump``: |jump - jump_ref| / |jump_ref|;
+        ``max``: the largest of these.
+    """
+    model = reference.model
+    errors = {}
+    speed_errors = []
+    for name in ("w_in_rad_s", "w_out_rad_s"):
+        ref = grid_values(reference, name)
+        scale = np.max(np.abs(ref))
+        if scale > 0:
+            speed_errors.append(np.max(np.abs(grid_values(run, name) - ref)) / scale)
+    errors["speeds"] = float(max(speed_errors, default=0.0))
+    gap_errors = []
+    for i in range(model.n):
+        ref = grid_values(reference, f"h_{i + 1}_m")
+        gap_errors.append(np.max(np.abs(grid_values(run, f"h_{i + 1}_m") - ref) / np.maximum(ref, model.sigma)))
+    errors["gaps"] = float(max(gap_errors))
+    errors["lock_time"] = _relative(run.summary["engagement_time_s"], reference.summary["engagement_time_s"])
+    errors["torque_jump"] = _relative(run.summary["lockup_torque_jump_Nm"], reference.summary["lockup_torque_jump_Nm"],
+                                      floor=1e-9 * reference.summary["peak_torque_Nm"])
+    errors["max"] = max(errors[k] for k in ERROR_PARTS)
+    return errors
+
+
+def reference_runs(scene, model):
+    """The reference run (IDAS, REFERENCE_RTOL) and its confirmation (CONFIRM_METHOD, CONFIRM_RTOL).
+
+    Returns
+    -------
+    reference : EngagementResult
+    confirmation : dict
+        ``method``, ``rtol`` and the confirmation's errors against the reference (None if the
+        confirming method failed, with ``failure``).
+    """
+    reference = run_method(scene, model, "idas", REFERENCE_RTOL)
+    confirmation = {"method": CONFIRM_METHOD, "rtol": CONFIRM_RTOL}
+    try:
+        other = run_method(scene, model, CONFIRM_METHOD, CONFIRM_RTOL)
+        confirmation["errors"] = trajectory_errors(other, reference)
+    except ClutchocpError as err:
+        confirmation.update(errors=None, failure=str(err)[:300])
+    return reference, confirmation
+
+
+def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=None, model=None):
+    """Every method over the tolerance sweep on one scene, against the reference.
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+    methods, tolerances : sequences
+    repeats : int
+        Timed runs per point (the best counts); the engine methods, whose runs are short and
+        noisy, get three times as many.
+    progress : clutchocp.bench.progress.Progress, optional
+    model : EngagementModel, optional
+
+    Returns
+    -------
+    dict
+        ``scene``, ``reference`` (summary numbers, solver statistics), ``confirmation`` and
+        ``rows`` (one per method and tolerance: wall and CPU time, errors, counts, status).
+    """
+    model = model or EngagementModel(scene)
+    reference, confirmation = reference_runs(scene, model)
+    ref_stats = reference.summary["solver"]["statistics"]
+    if progress:
+        err = confirmation["errors"]["max"] if confirmation.get("errors") else math.nan
+        progress.step(f"{scene.name}: reference IDAS rtol {REFERENCE_RTOL:g} ({ref_stats['n_steps']} steps), "
+                      f"{CONFIRM_METHOD} rtol {CONFIRM_RTOL:g} within {err:.1e}")
+    rows = []
+    for method in methods:
+        try:
+            run_method(scene, model, method, tolerances[0])                   # warm-up: builds, caches
+        except ModelError as exc:                                            # e.g. cvodes on a DAE mode
+            rows += [{"scene": scene.name, "method": method, "rtol": r, "status": f"n/a: {exc}"} for r in tolerances]
+            if progress:
+                progress.step(f"{scene.name} {method}: not applicable ({str(exc)[:80]})")
+            continue
+        except ClutchocpError:
+            pass
+        for rtol in tolerances:
+            row = {"scene": scene.name, "method": method, "rtol": rtol, "atol": rtol * ATOL_RATIO}
+            start = time.perf_counter()
+            try:
+                count = repeats * (3 if method in ("idas", "idas-native", "cvodes") else 1)
+                wall, cpu, run = timed_run(scene, model, method, rtol, count)
+            except ClutchocpError as exc:   # e.g. scipy BDF's step size collapsing at the impact
+                row.update(status=f"failed: {str(exc)[:200]}", wall_time_s=time.perf_counter() - start)
+                rows.append(row)
+                if progress:
+                    progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: FAILED ({str(exc)[:70]}...)")
+                continue
+            stats = run.summary["solver"]["statistics"]
+            errors = trajectory_errors(run, reference)
+            row.update(status="ok", wall_time_s=wall, cpu_time_s=cpu, error=errors["max"],
+                       **{f"error_{k}": errors[k] for k in ERROR_PARTS},
+                       engagement_time_s=run.summary["engagement_time_s"],
+                       n_steps=stats.get("n_steps"), n_rhs_evals=stats.get("n_rhs_evals", 0),
+                       n_jacobian_evals=stats.get("n_jacobian_evals", 0))
+            rows.append(row)
+            if progress:
+                progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: {wall * 1e3:8.1f} ms, error {errors['max']:.1e}")
+    return {"scene": scene.name,
+            "reference": {"method": "idas", "rtol": REFERENCE_RTOL, "atol": REFERENCE_RTOL * ATOL_RATIO,
+                          "engagement_time_s": reference.summary["engagement_time_s"],
+                          "lockup_torque_jump_Nm": reference.summary["lockup_torque_jump_Nm"],
+                          "n_steps": ref_stats.get("n_steps"), "wall_time_s": reference.summary["wall_time_s"]},
+            "confirmation": confirmation, "rows": rows, "reference_run": reference}
+
+
+def pareto_front(points):
+    """The (error, time) points no other point beats in both, sorted by error."""
+    front = []
+    for e, w in sorted((e, w) for e, w in points if math.isfinite(e) and e > 0 and math.isfinite(w)):
+        if not front or w < front[-1][1]:
+            front.append((e, w))
+    return front
+
+
+def time_at_error(points, level):
+    """Time to reach error ``level``: log-log interpolation along the Pareto front of (error, time)
+    points (the cheapest run that is at least that accurate); None outside the front's error range."""
+    front = pareto_front(points)
+    if not front or not front[0][0] <= level <= front[-1][0]:
+        return None
+    if len(front) == 1:
+        return front[0][1]
+    for (e0, w0), (e1, w1) in itertools.pairwise(front):
+        if e0 <= level <= e1:
+            s = (math.log(level) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(w0) + s * (math.log(w1) - math.log(w0)))
+    return None
+
+
+def points_of(rows, method, key="wall_time_s"):
+    """(error, time) of the successful rows of ``method``."""
+    return [(r["error"], r[key]) for r in rows if r["method"] == method and r.get("status") == "ok"]
+
+
+def speedups(rows, peers=PEERS, levels=ERROR_LEVELS, key="wall_time_s"):
+    """Time ratio peer / IDAS at each matched error level (None where either sweep does not reach it).
+
+    Returns
+    -------
+    dict
+        ``{peer: {level: ratio or None}}``.
+    """
+    idas = points_of(rows, "idas", key)
+    out = {}
+    for peer in peers:
+        other = points_of(rows, peer, key)
+        out[peer] = {}
+        for level in levels:
+            a, b = time_at_error(idas, level), time_at_error(other, level)
+            out[peer][level] = b / a if a is not None and b is not None else None
+    return out
+
+
+def headline(ratios):
+    """Geometric mean, minimum and count of the defined ratios of one peer (None if none)."""
+    values = [v for v in ratios.values() if v is not None]
+    if not values:
+        return None, None, 0
+    return float(np.exp(np.mean(np.log(values)))), float(min(values)), len(values)
+
+
+def write_rows(path, rows):
+    """The sweep table as CSV (one row per scene, method and tolerance)."""
+    columns = ("scene", "method", "rtol", "atol", "status", "wall_time_s", "cpu_time_s", "error",
+               *(f"error_{k}" for k in ERROR_PARTS), "engagement_time_s", "n_steps", "n_rhs_evals",
+               "n_jacobian_evals")
+
+    def cell(row, col):
+        value = row.get(col)
+        if value is None:
+            return ""
+        if isinstance(value, float) and not math.isfinite(value):
+            return "inf"
+        return value
+
+    return write_csv(path, {col: [cell(r, col) for r in rows] for col in columns})
+
+
+def plot_work_precision(results, path):
+    """Error against wall time (log-log), one panel per scene, one curve per method."""
+    fig, axes = new_figure(len(results), width=5.2, height=4.2)
+    for ax, res in zip(axes, results):
+        methods = list(dict.fromkeys(r["method"] for r in res["rows"]))
+        for method in methods:
+            pts = sorted(points_of(res["rows"], method))
+            if pts:
+                e, w = zip(*pts)
+                ax.loglog(e, np.array(w) * 1e3, "o-", ms=4, label=method)
+        ax.axvspan(min(ERROR_LEVELS), 1e-4, color="0.93", zorder=0)
+        ax.set(xlabel="error (speeds, gaps, lock time, torque jump) [relative]", ylabel="wall time [ms]",
+               title=f"{res['scene']}: work-precision")
+        ax.legend(fontsize=7)
+    return save_figure(fig, path)

@@ -1,0 +1,154 @@
+"""Benchmark machinery (clutchocp.bench): matched-error interpolation, growth exponents, error
+measures against a confirmed reference, CVODES on the engine, and one small end-to-end run of
+run_bench (the full and --quick runs are benchmarks, not tests)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from clutchocp.bench import optimization, scaling
+from clutchocp.bench import run as bench_run
+from clutchocp.bench import workprecision as wp
+from clutchocp.bench.progress import Progress
+from clutchocp.engagement.model import EngagementModel
+from clutchocp.engagement.run import simulate_engagement
+from clutchocp.errors import ModelError, SolverError
+from clutchocp.scene.loader import load_scene
+
+
+def test_time_at_error_interpolates_a_power_law_exactly():
+    # time = 2 error^-0.25: log-log linear, so interpolation between any two points is exact
+    points = [(e, 2 * e**-0.25) for e in (1e-3, 1e-5, 1e-7)]
+    assert wp.time_at_error(points, 1e-6) == pytest.approx(2 * 1e-6**-0.25, rel=1e-12)
+    assert wp.time_at_error(points, 1e-8) is None and wp.time_at_error(points, 1e-2) is None
+
+
+def test_time_at_error_uses_the_pareto_front():
+    # (1e-4, 5.0) is beaten by (1e-5, 2.0): more accurate and cheaper, so it is not on the front;
+    # a run without a finite error is left out
+    points = [(1e-3, 1.0), (1e-4, 5.0), (1e-5, 2.0), (math.inf, 0.1)]
+    assert wp.pareto_front(points) == [(1e-5, 2.0), (1e-3, 1.0)]
+    assert wp.time_at_error(points, 1e-4) == pytest.approx(math.sqrt(2.0), rel=1e-12)   # log-midpoint of 2 and 1
+
+
+def test_speedups_divide_peer_time_by_idas_time_at_each_level():
+    rows = [{"method": m, "status": "ok", "error": e, "wall_time_s": f * e**-0.2}
+            for m, f in (("idas", 1.0), ("Radau", 7.0)) for e in (1e-4, 1e-6, 1e-8)]
+    ratios = wp.speedups(rows, peers=("Radau",), levels=(1e-5, 1e-7, 1e-9))
+    assert ratios["Radau"][1e-5] == pytest.approx(7.0) and ratios["Radau"][1e-7] == pytest.approx(7.0)
+    assert ratios["Radau"][1e-9] is None
+    assert wp.headline(ratios["Radau"]) == (pytest.approx(7.0), pytest.approx(7.0), 2)
+
+
+def test_growth_exponent_of_a_power_law():
+    n = np.array([1, 2, 4, 8, 16])
+    assert scaling.growth_exponent(n, 3e-3 * n**1.25) == pytest.approx(1.25, rel=1e-12)
+
+
+def test_with_pairs_repeats_the_plate_mass():
+    scene = scaling.with_pairs(load_scene("bao2020"), 4)
+    assert scene.value("plates.n_interfaces") == 4
+    assert list(scene.value("pack.plate_masses")) == [pytest.approx(0.367)] * 4
+    assert scaling.with_pairs(load_scene("zhang2021"), 3).value("plates.n_interfaces") == 3
+
+
+@pytest.fixture(scope="module")
+def zhang():
+    scene = load_scene("zhang2021")
+    model = EngagementModel(scene)
+    reference, confirmation = wp.reference_runs(scene, model)
+    return scene, model, reference, confirmation
+
+
+def test_reference_is_confirmed_by_a_second_method(zhang):
+    """IDAS at rtol 1e-12 against scipy Radau at 1e-10 on the same equations: measured 3e-11."""
+    _, _, _, confirmation = zhang
+    assert confirmation["method"] == "Radau"
+    assert confirmation["errors"]["max"] <= 1e-9
+
+
+def test_error_measures_vanish_on_the_reference_and_shrink_with_the_tolerance(zhang):
+    scene, model, reference, _ = zhang
+    assert wp.trajectory_errors(reference, reference)["max"] == 0.0
+    loose = wp.trajectory_errors(wp.run_method(scene, model, "idas", 1e-5), reference)
+    tight = wp.trajectory_errors(wp.run_method(scene, model, "idas", 1e-8), reference)
+    assert set(loose) == {"speeds", "gaps", "lock_time", "torque_jump", "max"}
+    assert loose["max"] == max(loose[k] for k in wp.ERROR_PARTS)
+    assert 0 < tight["max"] < loose["max"] / 30        # three decades of tolerance, > 1.5 decades of error
+
+
+def test_a_run_that_never_locks_has_infinite_lock_time_error(zhang):
+    scene, model, reference, _ = zhang
+    short = simulate_engagement(scene, model=model, rtol=1e-8, atol=1e-10)
+    short.summary = dict(short.summary, engagement_time_s=None, lockup_torque_jump_Nm=None)
+    errors = wp.trajectory_errors(short, reference)
+    assert errors["lock_time"] == math.inf and errors["max"] == math.inf
+
+
+def test_engine_event_tolerances_follow_the_integration_tolerance():
+    assert wp.event_options(1e-4) == {"event_value_tol": 1e-6, "event_time_tol": 1e-9}
+    assert wp.event_options(1e-10) == {"event_value_tol": 1e-10, "event_time_tol": pytest.approx(1e-13)}
+
+
+def test_cvodes_integrates_the_same_equations_as_idas(zhang):
+    """CVODES (BDF, ODE) through the same hybrid engine: lock time within 1e-7 of the reference
+    at rtol 1e-9 (measured 6e-10), with its step counts reported."""
+    scene, model, reference, _ = zhang
+    run = wp.run_method(scene, model, "cvodes", 1e-9)
+    assert run.summary["solver"]["method"] == "cvodes"
+    assert run.summary["solver"]["statistics"]["n_steps"] > 0
+    assert wp.trajectory_errors(run, reference)["lock_time"] <= 1e-7
+
+
+def test_cvodes_refuses_a_mode_with_algebraic_variables():
+    """A compliant output shaft makes the clutch hub speed an algebraic variable: CVODES cannot
+    integrate that DAE, and says so."""
+    scene = load_scene("default_driveline").with_overrides({"driveline.shaft_stiffness": "5e3 N m",
+                                                           "driveline.shaft_damping": "5 N m s"})
+    with pytest.raises(ModelError, match="cvodes.*algebraic"):
+        simulate_engagement(scene, method="cvodes")
+
+
+def test_wall_time_cap_stops_every_method_with_a_clear_message():
+    scene = load_scene("bao2020")
+    model = EngagementModel(scene)
+    for method in ("idas", "cvodes", "Radau"):
+        with pytest.raises(SolverError, match="wall-time limit") as info:
+            simulate_engagement(scene, model=model, method=method, solver_options={"max_wall_time": 1e-4})
+        assert "Try:" in str(info.value)
+
+
+def test_progress_goes_to_the_given_stream(capsys):
+    import io
+
+    stream = io.StringIO()
+    bar = Progress(4, stream=stream)
+    bar.step("first")
+    bar.note("aside")
+    assert stream.getvalue().count("\n") == 2 and "1/4" in stream.getvalue() and "first" in stream.getvalue()
+    Progress(2, enabled=False).step("silent")
+    assert capsys.readouterr().err == ""
+
+
+def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
+    """A reduced run (one scene, two tolerances, two methods, two pack sizes, no optimisation)
+    through the real run_bench: every file and the summary keys the lead's CLI reports."""
+    monkeypatch.setitem(bench_run.QUICK, "tolerances", (1e-5, 1e-8))
+    monkeypatch.setitem(bench_run.QUICK, "methods", ("idas", "cvodes", "Radau", "BDF", "LSODA"))
+    monkeypatch.setattr(scaling, "PAIRS", (1, 2))
+    monkeypatch.setattr(optimization, "plan", lambda quick: None)
+    summary = bench_run.run_bench(tmp_path, quick=True, progress=False, scenes=[load_scene("zhang2021")])
+    names = {p.name for p in tmp_path.iterdir()}
+    assert {"summary.json", "engagement_work_precision.csv", "engagement_work_precision.png",
+            "engagement_speedup.csv", "scaling.csv", "scaling.png", "stiffness_zhang2021.png",
+            "stiffness_zhang2021.csv"} <= names
+    written = json.loads((tmp_path / "summary.json").read_text())
+    entry = written["scenes"]["zhang2021"]
+    for key in ("speedup_vs_radau", "speedup_vs_bdf", "speedup_vs_lsoda", "speedup_vs_cvodes",
+                "scaling_exponent_pairs", "stiffness"):
+        assert key in entry
+    assert entry["scaling"]["pairs"] == [1, 2]
+    assert written["optimization"]["available"] is False
+    assert summary["targets"]["scaling_exponent_max"] == 1.3

@@ -15,7 +15,7 @@ def run_example(name, out, *extra):
     proc = subprocess.run([sys.executable, str(EXAMPLES / name), "--out", str(out), *extra],
                           capture_output=True, text=True, timeout=300, env=env)
     assert proc.returncode == 0, proc.stderr[-2000:]
-    pngs = list(Path(out).glob("*.png"))
+    pngs = list(Path(out).rglob("*.png"))
     assert pngs and all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)
     return pngs
 

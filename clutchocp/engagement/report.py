@@ -31,10 +31,14 @@ def write_engagement(run, out_dir):
     return files
 
 
-def _mark_lock(ax, run):
+def _finish(fig, ax, run, path, legend=True):
+    """Mark the lock-up time, add the legend and save the figure; returns its path."""
     t_lock = run.summary["engagement_time_s"]
     if t_lock is not None:
         ax.axvline(t_lock, color="0.5", lw=0.8, ls="--", label="lock-up")
+    if legend:
+        ax.legend(fontsize=8)
+    return save_figure(fig, path)
 
 
 def plot_engagement(run, out):
@@ -48,32 +52,25 @@ def plot_engagement(run, out):
         ax.plot(t, res[f"h_{i + 1}_m"] * 1e6, label=f"film {i + 1}")
     ax.set(xlabel="time [s]", ylabel="film thickness [um]", title=f"{name}: oil films")
     ax.set_yscale("log")
-    _mark_lock(ax, run)
-    ax.legend(fontsize=8)
-    files.append(save_figure(fig, out / "gaps.png"))
+    files.append(_finish(fig, ax, run, out / "gaps.png"))
 
     fig, (ax,) = new_figure()
     ax.plot(t, res["w_in_rad_s"], label="input")
     ax.plot(t, res["w_out_rad_s"], label="output")
     ax.set(xlabel="time [s]", ylabel="speed [rad/s]", title=f"{name}: speeds")
-    _mark_lock(ax, run)
-    ax.legend(fontsize=8)
-    files.append(save_figure(fig, out / "speeds.png"))
+    files.append(_finish(fig, ax, run, out / "speeds.png"))
 
     fig, (ax,) = new_figure()
     ax.plot(t, res["viscous_torque_Nm"], label="viscous")
     ax.plot(t, res["contact_torque_Nm"], label="asperity contact")
     ax.plot(t, res["total_torque_Nm"], "k", lw=1.5, label="total")
     ax.set(xlabel="time [s]", ylabel="clutch torque [N m]", title=f"{name}: torque components")
-    _mark_lock(ax, run)
-    ax.legend(fontsize=8)
-    files.append(save_figure(fig, out / "torque.png"))
+    files.append(_finish(fig, ax, run, out / "torque.png"))
 
     fig, (ax,) = new_figure()
     ax.plot(t, res["pressure_Pa"] / 1e6)
     ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{name}: engagement pressure")
-    _mark_lock(ax, run)
-    files.append(save_figure(fig, out / "pressure.png"))
+    files.append(_finish(fig, ax, run, out / "pressure.png", legend=False))
     return files
 
 

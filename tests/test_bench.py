@@ -2,6 +2,7 @@
 measures against a confirmed reference, CVODES on the engine, and one small end-to-end run of
 run_bench (the full and --quick runs are benchmarks, not tests)."""
 
+import csv
 import json
 import math
 
@@ -152,3 +153,12 @@ def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
     assert entry["scaling"]["pairs"] == [1, 2]
     assert written["optimization"]["available"] is False
     assert summary["targets"]["scaling_exponent_max"] == 1.3
+    for key in ("speedup_vs_radau_integration", "speedup_vs_lsoda_integration"):
+        assert entry[key] is not None and entry[key] > 0
+    rows = [r for r in csv.DictReader(open(tmp_path / "engagement_work_precision.csv")) if r["status"] == "ok"]
+    for row in rows:     # the integrator calls are part of the run, so they take less time than it
+        assert 0 < float(row["integration_time_s"]) < float(row["wall_time_s"])
+    targets = written["engagement_targets"]
+    assert targets["speedup_min"] == {"Radau": 20.0, "LSODA": 5.0} and isinstance(targets["met"], bool)
+    assert written["single_run_s"] == {}          # bao2020 not among the scenes: not timed
+    assert all(m.startswith("zhang2021:") for m in targets["misses"])

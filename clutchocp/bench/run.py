@@ -11,7 +11,10 @@
 * ``summary.json`` -- per scene ``speedup_vs_radau``, ``speedup_vs_bdf``, ``speedup_vs_lsoda``,
   ``speedup_vs_cvodes`` (geometric mean over the matched error levels below 1e-4 that both
   sweeps reach; ``*_min`` the smallest), ``scaling_exponent_pairs`` and the stiffness extremes;
-  the targets of issue 6 and whether they were met.
+  the same ratios of the time spent inside the integrator calls alone (``*_integration``: IDAS
+  or ``solve_ivp``, without the event checks on the output grid, the outputs and the summary);
+  the targets of issue 6 and of issue 3 (speed-ups over Radau and LSODA on bao2020 and
+  zhang2021, one warm bao2020 engagement at the scene's settings) and whether they were met.
 
 ``quick=True`` leaves out IDAS with native code, times single runs (three for the engine methods)
 and solves coarser optimisation meshes (about a minute on two cores).
@@ -22,9 +25,11 @@ import time
 from pathlib import Path
 
 from ..engagement.model import EngagementModel
+from ..engagement.run import simulate_engagement
 from ..engagement.stiffness import stiffness_profile, write_stiffness
 from ..output import write_csv, write_summary
 from ..scene.loader import list_scenes
+from ..simulation.native import compiler
 from . import optimization, scaling, workprecision
 from .progress import Progress
 
@@ -34,6 +39,9 @@ QUICK = {"tolerances": workprecision.TOLERANCES, "methods": ("idas", "cvodes", "
          "repeats": 1, "scaling_repeats": 1}
 SCALING_TARGET = 1.3        # issue 6: growth exponent of run time in plate pairs <= 1.3
 SPEED_TARGET_BELOW = 1e-4   # issue 6: IDAS ahead of every scipy method at every matched error below 1e-4
+ENGAGEMENT_TARGETS = {"Radau": 20.0, "LSODA": 5.0}    # issue 3: IDAS speed-up at matched error (mean)
+ENGAGEMENT_TARGET_SCENES = ("bao2020", "zhang2021")
+SINGLE_RUN_SCENE, SINGLE_RUN_TARGET = "bao2020", 0.020   # issue 3: one warm engagement under 20 ms
 
 
 def engagement_scenes():
@@ -94,6 +102,8 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
     files.append(_write_scaling(scaling_results, out / "scaling.csv"))
     files.append(scaling.plot_scaling(scaling_results, out / "scaling.png"))
 
+    single = single_run_times(scenes, native=not quick)
+    bar.note(f"{SINGLE_RUN_SCENE}: one warm engagement " + ", ".join(f"{k} {v * 1e3:.1f} ms" for k, v in single.items()))
     opt_summary = optimization.convergence(out, quick=quick, progress=bar) if opt_plan else optimization.unavailable()
     files += [Path(p) for p in opt_summary.pop("files", [])]
 
@@ -102,7 +112,8 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
                             "repeats": settings["repeats"], "reference_rtol": workprecision.REFERENCE_RTOL,
                             "atol_over_rtol": workprecision.ATOL_RATIO,
                             "matched_error_levels": list(workprecision.ERROR_LEVELS)},
-               "targets": _targets(per_scene), "wall_time_s": time.perf_counter() - start}
+               "single_run_s": single, "targets": _targets(per_scene),
+               "engagement_targets": _engagement_targets(per_scene, single), "wall_time_s": time.perf_counter() - start}
     files.append(write_summary(out / "summary.json", json_ready(summary)))
     summary["files"] = [str(f) for f in files]
     bar.note(f"done in {summary['wall_time_s']:.0f} s; wrote {len(files)} files to {out}")
@@ -123,11 +134,11 @@ def json_ready(value):
 def _scene_summary(res, profile, scale, speed_rows):
     """The summary.json entry of one scene (and its rows of the speed-up table)."""
     entry = {"reference": res["reference"], "confirmation": res["confirmation"]}
-    for metric, key in (("wall", "wall_time_s"), ("cpu", "cpu_time_s")):
+    for metric, key in (("wall", "wall_time_s"), ("cpu", "cpu_time_s"), ("integration", "integration_time_s")):
         ratios = workprecision.speedups(res["rows"], key=key)
         for peer, by_level in ratios.items():
             mean, low, count = workprecision.headline(by_level)
-            name = f"speedup_vs_{peer.lower()}" + ("" if metric == "wall" else "_cpu")
+            name = f"speedup_vs_{peer.lower()}" + ("" if metric == "wall" else f"_{metric}")
             entry[name] = mean
             entry[f"{name}_min"] = low
             entry[f"{name}_levels"] = count
@@ -156,6 +167,45 @@ def _targets(per_scene):
             "met": not misses, "misses": misses}
 
 
+def single_run_times(scenes, repeats=5, native=True):
+    """Best wall time [s] of ``repeats`` warm runs of the issue 3 single-run scene at its own
+    settings: ``{"idas": t}``, plus ``"idas-native"`` when ``native`` and a C compiler is there
+    (empty if the scene is not among ``scenes``)."""
+    scene = next((s for s in scenes if s.name == SINGLE_RUN_SCENE), None)
+    if scene is None:
+        return {}
+    model = EngagementModel(scene)
+    times = {}
+    for method in ("idas", "idas-native") if native and compiler() else ("idas",):
+        run = lambda: simulate_engagement(scene, model=model, native=method == "idas-native")  # noqa: E731
+        run()                                                  # warm-up: builds and caches integrators
+        best = math.inf
+        for _ in range(repeats):
+            start = time.perf_counter()
+            run()
+            best = min(best, time.perf_counter() - start)
+        times[method] = best
+    return times
+
+
+def _engagement_targets(per_scene, single):
+    """Issue 3 targets, measured: mean speed-up at matched error over Radau and LSODA on the seed
+    scenes, and one warm engagement of the single-run scene."""
+    misses = []
+    for name in ENGAGEMENT_TARGET_SCENES:
+        entry = per_scene.get(name)
+        for peer, target in ENGAGEMENT_TARGETS.items() if entry else ():
+            ratio = entry.get(f"speedup_vs_{peer.lower()}")
+            if ratio is None or ratio < target:
+                misses.append(f"{name}: IDAS {'-' if ratio is None else f'{ratio:.1f}'}x faster than {peer} "
+                              f"(target {target:g}x)")
+    if "idas" in single and single["idas"] >= SINGLE_RUN_TARGET:
+        misses.append(f"{SINGLE_RUN_SCENE}: one engagement {single['idas'] * 1e3:.1f} ms "
+                      f"(target {SINGLE_RUN_TARGET * 1e3:g} ms)")
+    return {"speedup_min": ENGAGEMENT_TARGETS, "scenes": list(ENGAGEMENT_TARGET_SCENES),
+            "single_run_max_s": SINGLE_RUN_TARGET, "met": not misses, "misses": misses}
+
+
 def _write_scaling(results, path):
     rows = [(name, n, t, s, k) for name, res in results.items()
             for n, t, s, k in zip(res["pairs"], res["wall_time_s"], res["n_steps"], res["n_states"])]
@@ -175,6 +225,9 @@ def format_summary(summary):
                            for peer in ("radau", "bdf", "lsoda", "cvodes"))
         stiff = e["stiffness"]
         lines.append(f"  {name}: IDAS vs {ratios}")
+        inside = ", ".join(f"{peer} {num(e.get(f'speedup_vs_{peer}_integration'))}x"
+                           for peer in ("radau", "bdf", "lsoda", "cvodes"))
+        lines.append(f"    inside the integrator calls only: IDAS vs {inside}")
         lines.append(f"    run time ~ pairs^{e['scaling_exponent_pairs']:.2f}; stiffness ratio up to "
                      f"{num(stiff['max_stiffness_ratio'], '{:.3g}')}, fastest time constant "
                      f"{num(stiff['min_time_constant_s'], '{:.3g}')} s")
@@ -187,7 +240,12 @@ def format_summary(summary):
                                  for r in opt["rows"] if r.get("status") == "ok"))
     else:
         lines.append(f"  optimisation: not run ({opt.get('reason')})")
+    if summary.get("single_run_s"):
+        lines.append(f"  one warm {SINGLE_RUN_SCENE} engagement: "
+                     + ", ".join(f"{k} {v * 1e3:.1f} ms" for k, v in summary["single_run_s"].items()))
     targets = summary["targets"]
-    lines.append("  targets met" if targets["met"] else "  targets missed: " + "; ".join(targets["misses"]))
+    lines.append("  issue 6 targets met" if targets["met"] else "  issue 6 targets missed: " + "; ".join(targets["misses"]))
+    targets = summary["engagement_targets"]
+    lines.append("  issue 3 targets met" if targets["met"] else "  issue 3 targets missed: " + "; ".join(targets["misses"]))
     return "\n".join(lines)
 

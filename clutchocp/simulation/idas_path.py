@@ -163,7 +163,7 @@ class IdasPath:
         self.deadline = None
         self.counters = {v: 0 for v in _COUNTERS.values()}
         self.counters.update(n_integrator_calls=0, n_location_integrations=0, n_probe_integrations=0,
-                             n_integrators_built=0)
+                             n_integrators_built=0, integration_time_s=0.0)
         self._options_key = repr(sorted(self._idas_options(1.0).items())) + f"native={options.native}"
 
     # ------------------------------------------------------------------ IDAS calls
@@ -215,15 +215,17 @@ class IdasPath:
 
     def _run(self, entry, x0, z0, p):
         self.counters["n_integrator_calls"] += 1
+        start = time.perf_counter()
         try:
             xs, zs = entry(x0, z0, p)
         except RuntimeError as err:
-            self._count(entry.stats())
+            self._count(entry.stats(), start)
             raise _IdasFailure(idas_flag(err), str(err)) from None
-        self._count(entry.stats())
+        self._count(entry.stats(), start)
         return xs, zs
 
-    def _count(self, stats):
+    def _count(self, stats, start):
+        self.counters["integration_time_s"] += time.perf_counter() - start
         for key, name in _COUNTERS.items():
             self.counters[name] += int(stats.get(key, 0))
 

@@ -75,7 +75,7 @@ class ScipyPath:
         self.options = options
         self.deadline = None          # time.perf_counter() limit (SimulationOptions.max_wall_time)
         self.counters = {"n_rhs_evals": 0, "n_jacobian_evals": 0, "n_lu_decompositions": 0,
-                         "n_integrator_calls": 0}
+                         "n_integrator_calls": 0, "integration_time_s": 0.0}
 
     def _functions(self, cm, pu):
         red = cm.integrators.get("scipy_reduced")
@@ -123,9 +123,11 @@ class ScipyPath:
             events.append(event)
         kwargs = {"max_step": o.max_step} if o.max_step is not None else {}
         self.counters["n_integrator_calls"] += 1
+        start = time.perf_counter()
         with np.errstate(all="ignore"):
             sol = solve_ivp(rhs, (float(t_a), float(times[-1])), np.asarray(xs_a, float), method=self.method,
                             t_eval=times, events=events or None, rtol=o.rtol, atol=o.atol, jac=jac, **kwargs)
+        self.counters["integration_time_s"] += time.perf_counter() - start
         self.counters["n_rhs_evals"] += int(sol.nfev)
         self.counters["n_jacobian_evals"] += int(sol.njev)
         self.counters["n_lu_decompositions"] += int(sol.nlu)

@@ -15,6 +15,7 @@ import numpy as np
 
 from clutchocp.errors import ModelError
 from clutchocp.simulation.model import time_derivative
+from clutchocp.simulation.vectorized import MIN_SAMPLES, numpy_function
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,7 @@ class ColumnFunction:
         self.n_out = function.size1_out(0)
         self._maps = {}
         self._max_maps = max_maps
+        self._numpy = numpy_function(function)     # many samples: one numpy operation per instruction
 
     def _map(self, n):
         entry = self._maps.pop(n, None)
@@ -73,6 +75,12 @@ class ColumnFunction:
         t = np.atleast_1d(np.asarray(t, float)).ravel()
         n = t.size
         nx, nz = self.sizes[:2]
+        if self._numpy is not None and n >= MIN_SAMPLES:
+            out = np.empty((self.n_out, n))
+            with np.errstate(all="ignore"):       # as CasADi: NaN/inf where the expression gives them
+                self._numpy([np.reshape(np.asarray(xs, float), (nx, n)), np.reshape(np.asarray(zs, float), (nz, n)),
+                             np.ravel(np.asarray(pu, float)), t[None, :]], [out])
+            return out
         _, buf, evaluate = self._map(n)
         args = [np.ascontiguousarray(np.reshape(np.asarray(xs, float), (nx, n)).T),
                 np.ascontiguousarray(np.reshape(np.asarray(zs, float), (nz, n)).T),

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from clutchocp.engagement.run import simulate_engagement
+from clutchocp.engagement.run import _first_crossing as first_crossing, simulate_engagement
 from clutchocp.scene.loader import load_scene
 
 
@@ -25,13 +25,6 @@ def zhang(overrides, **kw):
 # Zhang's torque peaks come before 0.2 s: a 0.1 ms output grid up to 0.4 s resolves the response
 # times to 1e-6 s (the scene's 2 ms grid over 4 s interpolates them to ~5e-5 s).
 ZHANG_FINE = {"t_end": 0.4, "output_points": 4001}
-
-
-def first_crossing(t, y, level):
-    """First time y reaches ``level`` (linear interpolation between output points)."""
-    k = int(np.argmax(y >= level))
-    assert y[k] >= level and k > 0
-    return t[k - 1] + (level - y[k - 1]) * (t[k] - t[k - 1]) / (y[k] - y[k - 1])
 
 
 # ------------------------------------------------------------------------------- Bao 2020

@@ -147,7 +147,7 @@ def response_times(model, result):
     rise = lambda frac: _first_crossing(t, (p - p0) / (p_set - p0), frac) if p_set != p0 else None  # noqa: E731
     t10, t50, t90 = rise(0.1), rise(0.5), rise(0.9)
     pressure_time = t90 - t10 if t10 is not None and t90 is not None else None
-    slipping = ~np.char.endswith(result.mode.astype(str), "locked")
+    slipping = np.concatenate([np.full(seg.t.size, not str(seg.mode).endswith("locked")) for seg in result.segments])
     torque = np.abs(result["total_torque_Nm"])
     torque_time = None
     if t50 is not None and slipping.any():

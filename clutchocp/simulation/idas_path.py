@@ -183,7 +183,7 @@ class IdasPath:
     def _integrator(self, cm, taus, span):
         """The cached integrator of ``cm`` with outputs at normalised times ``taus``."""
         n = len(taus)
-        uniform = np.allclose(taus, np.arange(1, n + 1) / n, rtol=0, atol=1e-9)
+        uniform = float(np.max(np.abs(taus - np.arange(1, n + 1) / n))) <= 1e-9
         pattern = n if uniform else tuple(np.round(taus, 12))
         key = (self._options_key, pattern, span if self.options.max_step is not None else None)
         cache = cm.integrators.setdefault(self.plugin, OrderedDict())

@@ -1,6 +1,6 @@
 """Settings of a hybrid simulation (shared by the IDAS and scipy paths)."""
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 
 from clutchocp.errors import ModelError
 
@@ -92,5 +92,7 @@ class SimulationOptions:
             raise ModelError(f"SimulationOptions.chunk_growth must be >= 1 or None, got {self.chunk_growth!r}")
 
     def as_dict(self):
-        """Plain dictionary (for summaries)."""
-        return asdict(self)
+        """Plain dictionary (for summaries; the option values are numbers, strings, None and one
+        flat dict of IDAS options, copied)."""
+        return {f.name: dict(getattr(self, f.name)) if f.name == "idas_options" else getattr(self, f.name)
+                for f in fields(self)}

@@ -70,7 +70,7 @@ class SimulationResult:
         return list(seen)
 
     def __getitem__(self, name):
-        if name not in self.names():
+        if name not in self:
             raise KeyError(f"'{name}' is not a state, algebraic variable or output of this run; "
                            f"known: {self.names()}")
         parts = []
@@ -80,7 +80,7 @@ class SimulationResult:
         return np.concatenate(parts)
 
     def __contains__(self, name):
-        return name in self.names()
+        return any(name in seg.x or name in seg.z or name in seg.outputs for seg in self.segments)
 
     @property
     def final_mode(self):

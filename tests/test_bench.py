@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from clutchocp.bench import optimization, scaling
+from clutchocp.bench import floor, optimization, scaling
 from clutchocp.bench import run as bench_run
 from clutchocp.bench import workprecision as wp
 from clutchocp.bench.progress import Progress
@@ -133,6 +133,34 @@ def test_progress_goes_to_the_given_stream(capsys):
     assert capsys.readouterr().err == ""
 
 
+def test_floor_pieces_run_from_switch_to_switch(zhang):
+    """zhang2021 slips, then locks: two pieces, the first from t = 0 to the lock-up event, the
+    second from the state after the lock-up (locked mode) to the end."""
+    scene, model, reference, _ = zhang
+    parts = floor.pieces(reference)
+    lock = reference.result.events[-1]
+    assert [p[0].name for p in parts] == [lock.source, lock.target]
+    assert parts[0][1] == 0.0 and parts[0][4] == pytest.approx(lock.t, abs=0)
+    assert parts[1][1] == lock.t and parts[1][4] == scene.value("simulation.t_end")
+    cm = parts[1][0]
+    after = np.array([lock.x_after[n] for n in cm.x_names]) / cm.x_nominal
+    assert np.array_equal(parts[1][2], after)
+
+
+def test_floor_pieces_reproduce_the_reference_with_both_integrators(zhang):
+    """Each piece integrated alone from the reference state at its start, by IDAS and by scipy
+    Radau (independent integrators), ends on the reference state; the error shrinks with rtol."""
+    _, model, reference, _ = zhang
+    parts = floor.pieces(reference)
+    errors = {}
+    for method in ("idas", "Radau"):
+        for rtol in (1e-5, 1e-9):
+            time_s, errors[method, rtol] = floor.floor_run(model, parts, method, rtol, repeats=1)
+            assert time_s > 0
+        assert errors[method, 1e-9] < errors[method, 1e-5]
+        assert errors[method, 1e-9] <= 1e-7
+
+
 def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
     """A reduced run (one scene, two tolerances, two methods, two pack sizes, no optimisation)
     through the real run_bench: every file and the summary keys the lead's CLI reports."""
@@ -143,7 +171,7 @@ def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
     summary = bench_run.run_bench(tmp_path, quick=True, progress=False, scenes=[load_scene("zhang2021")])
     names = {p.name for p in tmp_path.iterdir()}
     assert {"summary.json", "engagement_work_precision.csv", "engagement_work_precision.png",
-            "engagement_speedup.csv", "scaling.csv", "scaling.png", "stiffness_zhang2021.png",
+            "engagement_speedup.csv", "engagement_integrator_floor.csv", "scaling.csv", "scaling.png", "stiffness_zhang2021.png",
             "stiffness_zhang2021.csv"} <= names
     written = json.loads((tmp_path / "summary.json").read_text())
     entry = written["scenes"]["zhang2021"]
@@ -158,6 +186,14 @@ def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
     rows = [r for r in csv.DictReader(open(tmp_path / "engagement_work_precision.csv")) if r["status"] == "ok"]
     for row in rows:     # the integrator calls are part of the run, so they take less time than it
         assert 0 < float(row["integration_time_s"]) < float(row["wall_time_s"])
+    whole = {(r["method"], r["rtol"]): r for r in rows}
+    low = [r for r in csv.DictReader(open(tmp_path / "engagement_integrator_floor.csv")) if r["status"] == "ok"]
+    assert {r["method"] for r in low} == {"idas", "Radau", "LSODA"}
+    for row in low:      # the floor leaves out the grid work of the whole run and keeps its error
+        assert 0 < float(row["time_s"]) < float(whole[row["method"], row["rtol"]]["wall_time_s"])
+        assert row["error"] == whole[row["method"], row["rtol"]]["error"]
+    for key in ("floor_speedup_vs_radau", "floor_speedup_vs_lsoda"):
+        assert entry[key] is not None and entry[key] > 0
     targets = written["engagement_targets"]
     assert targets["speedup_min"] == {"Radau": 20.0, "LSODA": 5.0} and isinstance(targets["met"], bool)
     assert written["single_run_s"] == {}          # bao2020 not among the scenes: not timed

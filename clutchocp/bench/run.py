@@ -13,8 +13,12 @@
   sweeps reach; ``*_min`` the smallest), ``scaling_exponent_pairs`` and the stiffness extremes;
   the same ratios of the time spent inside the integrator calls alone (``*_integration``: IDAS
   or ``solve_ivp``, without the event checks on the output grid, the outputs and the summary);
+  the integrator floor (``floor_speedup_vs_radau``, ``floor_speedup_vs_lsoda``: the integrators
+  alone with the event times known, :mod:`clutchocp.bench.floor`);
   the targets of issue 6 and of issue 3 (speed-ups over Radau and LSODA on bao2020 and
-  zhang2021, one warm bao2020 engagement at the scene's settings) and whether they were met.
+  zhang2021, one warm bao2020 engagement at the scene's settings) and whether they were met;
+* ``engagement_integrator_floor.csv`` -- the floor of every method and tolerance (also drawn,
+  dashed, on the work-precision figure).
 
 ``quick=True`` leaves out IDAS with native code, times single runs (three for the engine methods)
 and solves coarser optimisation meshes (about a minute on two cores).
@@ -30,7 +34,7 @@ from ..engagement.stiffness import stiffness_profile, write_stiffness
 from ..output import write_csv, write_summary
 from ..scene.loader import list_scenes
 from ..simulation.native import compiler
-from . import optimization, scaling, workprecision
+from . import floor, optimization, scaling, workprecision
 from .progress import Progress
 
 FULL = {"tolerances": workprecision.TOLERANCES, "methods": workprecision.METHODS, "repeats": 3,
@@ -50,7 +54,7 @@ def engagement_scenes():
 
 
 def _steps(settings, n_scenes, opt_steps):
-    per_scene = 1 + len(settings["methods"]) * len(settings["tolerances"]) + 1 + len(scaling.PAIRS)
+    per_scene = 1 + len(settings["methods"]) * len(settings["tolerances"]) + 2 + len(scaling.PAIRS)
     return n_scenes * per_scene + opt_steps
 
 
@@ -81,22 +85,28 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
     scenes = list(scenes) if scenes is not None else engagement_scenes()
     opt_plan = optimization.plan(quick)
     bar = Progress(_steps(settings, len(scenes), len(opt_plan["meshes"]) + 1 if opt_plan else 0), enabled=progress)
-    files, results, per_scene, scaling_results, speed_rows = [], [], {}, {}, []
+    files, results, per_scene, scaling_results, speed_rows, floors = [], [], {}, {}, [], {}
 
     for scene in scenes:
         model = EngagementModel(scene)
         res = workprecision.sweep(scene, methods=settings["methods"], tolerances=settings["tolerances"],
                                   repeats=settings["repeats"], progress=bar, model=model)
         results.append(res)
+        low = floor.integrator_floor(res["reference_run"], res["rows"], repeats=settings["repeats"], progress=bar)
+        floors[scene.name] = low.pop("rows")
+        bar.step(f"{scene.name}: integrator floor {low['floor_speedup_vs_radau'] or math.nan:.1f}x over Radau, "
+                 f"{low['floor_speedup_vs_lsoda'] or math.nan:.1f}x over LSODA")
         profile = stiffness_profile(res.pop("reference_run"))
         files += write_stiffness(profile, out)
         bar.step(f"{scene.name}: stiffness ratio up to {profile.summary()['max_stiffness_ratio']:.3g}")
         scaling_results[scene.name] = scaling.plate_pair_scaling(scene, pairs=scaling.PAIRS,
                                                                  repeats=settings["scaling_repeats"], progress=bar)
-        per_scene[scene.name] = _scene_summary(res, profile, scaling_results[scene.name], speed_rows)
+        per_scene[scene.name] = {**_scene_summary(res, profile, scaling_results[scene.name], speed_rows), **low}
 
     files.append(workprecision.write_rows(out / "engagement_work_precision.csv", [r for res in results for r in res["rows"]]))
-    files.append(workprecision.plot_work_precision(results, out / "engagement_work_precision.png"))
+    files.append(workprecision.write_rows(out / "engagement_integrator_floor.csv", [r for rows in floors.values() for r in rows],
+                                          floor.COLUMNS))
+    files.append(workprecision.plot_work_precision(results, out / "engagement_work_precision.png", floors))
     files.append(write_csv(out / "engagement_speedup.csv", {
         key: [row[key] for row in speed_rows] for key in ("scene", "peer", "error_level", "time_ratio_to_idas")}))
     files.append(_write_scaling(scaling_results, out / "scaling.csv"))
@@ -197,8 +207,9 @@ def _engagement_targets(per_scene, single):
         for peer, target in ENGAGEMENT_TARGETS.items() if entry else ():
             ratio = entry.get(f"speedup_vs_{peer.lower()}")
             if ratio is None or ratio < target:
+                low = entry.get(f"floor_speedup_vs_{peer.lower()}")
                 misses.append(f"{name}: IDAS {'-' if ratio is None else f'{ratio:.1f}'}x faster than {peer} "
-                              f"(target {target:g}x)")
+                              f"(target {target:g}x; integrator floor {'-' if low is None else f'{low:.1f}'}x)")
     if "idas" in single and single["idas"] >= SINGLE_RUN_TARGET:
         misses.append(f"{SINGLE_RUN_SCENE}: one engagement {single['idas'] * 1e3:.1f} ms "
                       f"(target {SINGLE_RUN_TARGET * 1e3:g} ms)")
@@ -228,6 +239,8 @@ def format_summary(summary):
         inside = ", ".join(f"{peer} {num(e.get(f'speedup_vs_{peer}_integration'))}x"
                            for peer in ("radau", "bdf", "lsoda", "cvodes"))
         lines.append(f"    inside the integrator calls only: IDAS vs {inside}")
+        lines.append(f"    integrator floor (event times known, one call per mode piece): IDAS vs Radau "
+                     f"{num(e.get('floor_speedup_vs_radau'))}x, LSODA {num(e.get('floor_speedup_vs_lsoda'))}x")
         lines.append(f"    run time ~ pairs^{e['scaling_exponent_pairs']:.2f}; stiffness ratio up to "
                      f"{num(stiff['max_stiffness_ratio'], '{:.3g}')}, fastest time constant "
                      f"{num(stiff['min_time_constant_s'], '{:.3g}')} s")

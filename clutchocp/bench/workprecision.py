@@ -268,11 +268,13 @@ def headline(ratios):
     return float(np.exp(np.mean(np.log(values)))), float(min(values)), len(values)
 
 
-def write_rows(path, rows):
-    """The sweep table as CSV (one row per scene, method and tolerance)."""
-    columns = ("scene", "method", "rtol", "atol", "status", "wall_time_s", "cpu_time_s", "integration_time_s", "error",
-               *(f"error_{k}" for k in ERROR_PARTS), "engagement_time_s", "n_steps", "n_rhs_evals",
-               "n_jacobian_evals")
+SWEEP_COLUMNS = ("scene", "method", "rtol", "atol", "status", "wall_time_s", "cpu_time_s", "integration_time_s",
+                 "error", *(f"error_{k}" for k in ERROR_PARTS), "engagement_time_s", "n_steps", "n_rhs_evals",
+                 "n_jacobian_evals")
+
+
+def write_rows(path, rows, columns=SWEEP_COLUMNS):
+    """A table of rows as CSV (the sweep: one row per scene, method and tolerance)."""
 
     def cell(row, col):
         value = row.get(col)
@@ -285,16 +287,23 @@ def write_rows(path, rows):
     return write_csv(path, {col: [cell(r, col) for r in rows] for col in columns})
 
 
-def plot_work_precision(results, path):
-    """Error against wall time (log-log), one panel per scene, one curve per method."""
+def plot_work_precision(results, path, floors=None):
+    """Error against wall time (log-log), one panel per scene, one curve per method; with
+    ``floors`` (``{scene: rows of clutchocp.bench.floor.integrator_floor}``) the integrator
+    floor of each method as a dashed curve of the same colour."""
     fig, axes = new_figure(len(results), width=5.2, height=4.2)
     for ax, res in zip(axes, results):
         methods = list(dict.fromkeys(r["method"] for r in res["rows"]))
+        floor_rows = (floors or {}).get(res["scene"], [])
         for method in methods:
             pts = sorted(points_of(res["rows"], method))
             if pts:
                 e, w = zip(*pts)
-                ax.loglog(e, np.array(w) * 1e3, "o-", ms=4, label=method)
+                line, = ax.loglog(e, np.array(w) * 1e3, "o-", ms=4, label=method)
+                low = sorted(points_of(floor_rows, method, key="time_s"))
+                if low:
+                    e, w = zip(*low)
+                    ax.loglog(e, np.array(w) * 1e3, "x--", ms=4, color=line.get_color(), label=f"{method} floor")
         ax.axvspan(min(ERROR_LEVELS), 1e-4, color="0.93", zorder=0)
         ax.set(xlabel="error (speeds, gaps, lock time, torque jump) [relative]", ylabel="wall time [ms]",
                title=f"{res['scene']}: work-precision")

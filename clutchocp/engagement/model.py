@@ -9,7 +9,10 @@ shape); a part that the scene does not declare adds no state:
     p_valve           valve output pressure                    (actuation.model = "valve_lag")
     w_in              input speed                              (driveline.input = "inertia")
     w_out             output speed                             (driveline.output = "inertia")
-    E_*               energy accumulators for the balance check (always)
+    theta_shaft       output shaft twist                       (driveline.shaft_stiffness given)
+    E_*               energy accumulators for the balance check: source, hydraulic, slip, film,
+                      contact, impact (always); load (a load on an output inertia), seal (a
+                      piston), spline (splines), shaft (a compliant shaft)
 
 Modes are (axial phase) x (rotation): axial phase "approach" (piston travelling freely, plates at
 rest; only with a piston and free travel) or "pressing"; rotation "slip_forward" (w_in > w_out),
@@ -121,7 +124,11 @@ class EngagementModel:
         if self.compliant:
             torque_scale = max(abs(s.value("driveline.input_torque")), 10.0)
             add("theta_shaft", torque_scale / self.shaft_stiffness, 0.0)
-        for name in ENERGY_TERMS:
+        # Energy accumulators of the parts the scene has (a load, a piston seal, splines, a shaft)
+        present = {"E_load": self.output_inertia and s.variant("load") not in ("", "none"),
+                   "E_seal": self.has_piston, "E_spline": s.has("spline"), "E_shaft": self.compliant}
+        self.energy_terms = tuple(name for name in ENERGY_TERMS if present.get(name, True))
+        for name in self.energy_terms:
             add(name, 1.0, 0.0)
         self.state_names = tuple(names)
         self.nominal = np.array(nominal, dtype=float)
@@ -136,7 +143,7 @@ class EngagementModel:
     @property
     def n_states(self):
         """Number of physical states (energy accumulators excluded)."""
-        return len(self.state_names) - len(ENERGY_TERMS)
+        return len(self.state_names) - len(self.energy_terms)
 
     # -- parts --------------------------------------------------------------------------------
     def speeds(self):

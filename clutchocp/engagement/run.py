@@ -164,7 +164,7 @@ def energy_balance(model, result):
     (elastic) storage + dissipation (slip, film, seal, splines, shaft damping, impact); the spring
     energy includes the twist of a compliant shaft.
     """
-    E = {name: result.final(name) for name in ENERGY_TERMS}
+    E = {name: result.final(name) if name in model.energy_terms else 0.0 for name in ENERGY_TERMS}
     ke = result["kinetic_energy_J"]
     spring = result["spring_energy_J"]
     work_in = E["E_source"] + E["E_hydraulic"] - E["E_load"] + (spring[0] - spring[-1])

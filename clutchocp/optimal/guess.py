@@ -58,7 +58,7 @@ def guess_from_run(ocp, run, t_max=None):
     starts, points = tr.node_times(1.0)                 # normalised times s in [0, 1]
     res = run.result
 
-    energy = sum(res[name][idx] for name in DISSIPATED)
+    energy = sum(res[name][idx] for name in DISSIPATED if name in run.model.energy_terms)
 
     def states_at(s):
         cols = [np.interp(s * t_lock, t, res[name][idx]) / nominal

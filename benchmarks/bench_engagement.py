@@ -3,8 +3,9 @@
 A thin caller of :mod:`clutchocp.bench.workprecision` (the same sweep ``clutchocp bench`` runs on
 every engagement scene; see that module for the error measure, the confirmed reference and the
 matched-error ratios). This script runs the sweep on the scenes given, prints the time ratio of
-each peer to IDAS at matched error levels (wall and CPU time), and the single-run figure of
-issue 3: one bao2020 engagement at the scene's tolerance, warm and cold.
+each peer to IDAS at matched error levels (wall and CPU time), the integrator floor
+(:mod:`clutchocp.bench.floor`: the integrators alone, event times known), and the single-run
+figure of issue 3: one bao2020 engagement at the scene's tolerance, warm and cold.
 
 Usage::
 
@@ -18,15 +19,16 @@ import sys
 import time
 from pathlib import Path
 
+from clutchocp.bench import floor
 from clutchocp.bench import workprecision as wp
+from clutchocp.bench.run import ENGAGEMENT_TARGETS as TARGETS
+from clutchocp.bench.run import SINGLE_RUN_TARGET as SINGLE_RUN_TARGET_S
 from clutchocp.bench.progress import Progress
 from clutchocp.engagement.model import EngagementModel
 from clutchocp.engagement.run import simulate_engagement
 from clutchocp.scene.loader import load_scene
 
 LEVELS = (1e-5, 1e-6, 1e-7, 1e-8)
-TARGETS = {"Radau": 20.0, "LSODA": 5.0}          # issue 3: IDAS >= 20x Radau, >= 5x LSODA at matched error
-SINGLE_RUN_TARGET_S = 0.020
 
 
 def single_run(method, repeats=20):
@@ -56,16 +58,23 @@ def main(argv=None):
     methods = tuple(m for m in wp.METHODS if not (args.quick and m == "idas-native"))
     tolerances = (1e-4, 1e-6, 1e-8, 1e-10) if args.quick else wp.TOLERANCES
 
-    progress = Progress(len(args.scenes) * (1 + len(methods) * len(tolerances)) + 2)
-    results = [wp.sweep(load_scene(name), methods=methods, tolerances=tolerances, repeats=args.repeats,
-                        progress=progress) for name in args.scenes]
+    progress = Progress(len(args.scenes) * (2 + len(methods) * len(tolerances)) + 2)
+    results, floors = [], {}
+    for name in args.scenes:
+        res = wp.sweep(load_scene(name), methods=methods, tolerances=tolerances, repeats=args.repeats,
+                       progress=progress)
+        floors[name] = floor.integrator_floor(res.pop("reference_run"), res["rows"], repeats=args.repeats,
+                                              progress=progress)
+        progress.step(f"{name}: integrator floor")
+        results.append(res)
     single = {}
     for method in ("idas", "idas-native"):
         single[method] = single_run(method)
         progress.step(f"single bao2020 run, {method}")
 
     csv_path = wp.write_rows(out / "engagement_work_precision.csv", [r for res in results for r in res["rows"]])
-    png_path = wp.plot_work_precision(results, out / "engagement_work_precision.png")
+    png_path = wp.plot_work_precision(results, out / "engagement_work_precision.png",
+                                      {name: low["rows"] for name, low in floors.items()})
 
     print("\nTime ratio of each method to IDAS at matched error (Pareto front of each sweep, log-log; "
           "'-': level outside a sweep); wall time, CPU time in brackets:")
@@ -84,6 +93,10 @@ def main(argv=None):
                 if peer in TARGETS and level == 1e-6 and ratio is not None and ratio < TARGETS[peer]:
                     failed.append(f"{res['scene']} {peer} {ratio:.1f}x < {TARGETS[peer]:g}x at 1e-6")
             print(f"    error {level:.0e}: IDAS {_ms(idas)} | " + " | ".join(cells))
+        low = floors[res["scene"]]
+        print("    integrator floor (event times known, one call per mode piece), mean over matched errors: "
+              + ", ".join(f"{peer} {low[f'floor_speedup_vs_{peer.lower()}']:.1f}x" for peer in floor.PEERS
+                          if low.get(f"floor_speedup_vs_{peer.lower()}") is not None))
     print()
     for method, (warm, warm_cpu, cold, steps) in single.items():
         print(f"One bao2020 engagement at rtol 1e-8 (scene tolerance), {method}: warm {warm * 1e3:.1f} ms wall, "

@@ -51,14 +51,6 @@ def pieces(reference):
     return out
 
 
-def _parameters(model, t):
-    """Parameter and input vector of the engagement model at time ``t`` (it has no free inputs)."""
-    hybrid = model.hybrid
-    if hybrid.p or hybrid.u:
-        raise ClutchocpError("the integrator floor needs a model with its parameters built in (no free inputs)")
-    return np.zeros(0)
-
-
 def _idas_piece(path, cm, t0, xs0, zs0, pu, t1):
     try:
         xs, _ = path._integrate_to(cm, t0, xs0, zs0, pu, t1)
@@ -87,14 +79,16 @@ def floor_run(model, parts, method, rtol, repeats=3):
     error : float
         Largest relative error of the scaled end states (see the module docstring).
     """
+    if model.hybrid.p or model.hybrid.u:
+        raise ClutchocpError("the integrator floor needs a model with its parameters built in (no free inputs)")
+    pu = np.zeros(0)                                  # the engagement model's values are built in
     atol = rtol * workprecision.ATOL_RATIO
     options = SimulationOptions(rtol=rtol, atol=atol)
     path = IdasPath(options) if method == "idas" else ScipyPath(method, options)
     best, error = math.inf, 0.0
-    for _ in range(max(1, repeats) + 1):             # the first pass builds and caches the integrators
+    for attempt in range(max(1, repeats) + 1):       # the first pass builds and caches the integrators
         total, worst = 0.0, 0.0
         for cm, t0, xs0, zs0, t1, xs_ref in parts:
-            pu = _parameters(model, t0)
             start = time.perf_counter()
             if method == "idas":
                 xs = _idas_piece(path, cm, t0, xs0, zs0, pu, t1)
@@ -102,7 +96,7 @@ def floor_run(model, parts, method, rtol, repeats=3):
                 xs = _scipy_piece(path, method, cm, t0, xs0, pu, t1, rtol, atol)
             total += time.perf_counter() - start
             worst = max(worst, float(np.max(np.abs(xs - xs_ref) / np.maximum(1.0, np.abs(xs_ref)))))
-        if _ > 0:
+        if attempt > 0:
             best = min(best, total)
         error = worst
     return best, error

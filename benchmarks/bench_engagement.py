@@ -21,9 +21,9 @@ from pathlib import Path
 
 from clutchocp.bench import floor
 from clutchocp.bench import workprecision as wp
+from clutchocp.bench.progress import Progress
 from clutchocp.bench.run import ENGAGEMENT_TARGETS as TARGETS
 from clutchocp.bench.run import SINGLE_RUN_TARGET as SINGLE_RUN_TARGET_S
-from clutchocp.bench.progress import Progress
 from clutchocp.engagement.model import EngagementModel
 from clutchocp.engagement.run import simulate_engagement
 from clutchocp.scene.loader import load_scene

@@ -135,7 +135,7 @@ def _first_crossing(t, y, level):
     return float(t[k - 1] + (level - y[k - 1]) * (t[k] - t[k - 1]) / (y[k] - y[k - 1]))
 
 
-def _pressure_rise(model, result, fraction):
+def pressure_rise_time(model, result, fraction):
     """First time [s] the pressure has risen by ``fraction`` of the way to the set pressure, or None."""
     p_set = model.scene.value("actuation.pressure")
     p0 = model.scene.value("actuation.initial_pressure")
@@ -157,7 +157,7 @@ def response_times(model, result):
     own definition, to the stable torque, is :func:`stable_torque_response`.
     """
     t = result.t
-    t10, t50, t90 = (_pressure_rise(model, result, frac) for frac in (0.1, 0.5, 0.9))
+    t10, t50, t90 = (pressure_rise_time(model, result, frac) for frac in (0.1, 0.5, 0.9))
     pressure_time = t90 - t10 if t10 is not None and t90 is not None else None
     slipping = _slipping(result)
     torque = np.abs(result["total_torque_Nm"])
@@ -192,7 +192,7 @@ def stable_torque_response(model, result):
         return None, None
     t, contact_torque = result.t[slipping], np.abs(result["contact_torque_Nm"][slipping])
     stable = float(contact_torque[-1])
-    t50 = _pressure_rise(model, result, 0.5)
+    t50 = pressure_rise_time(model, result, 0.5)
     if stable <= 0 or t50 is None:
         return (stable if stable > 0 else None), None
     t90 = _first_crossing(t, contact_torque, 0.9 * stable)

@@ -95,3 +95,20 @@ def test_energy_balance_and_radau_are_covered_by_the_scene_tests():
     engagement scene in models/; this scene is among them."""
     from tests.test_engagement import ENGAGEMENT_SCENES
     assert "bao2020_as_published" in ENGAGEMENT_SCENES
+
+
+@pytest.mark.parametrize("name", ["bao2020", "bao2020_as_published"])
+def test_both_scenes_have_the_shapes_bao_figures_9_and_10_describe(runs, name):
+    """What Bao's text says of his Figs. 9-10 (the figures themselves give no numbers that decide
+    between the scenes): both films 'decrease to the same film thickness'; the viscous torque rises,
+    then falls 'until it reaches zero' (measured at lock: 0.2 % / 0.06 % of its peak); the torque 'at
+    the lock is sharply increased, forming a peak' (1.36 times its low after the viscous peak on
+    both scenes: the Stribeck coefficient rises from 0.10 to 0.14 as the slip ends)."""
+    run = runs[name]
+    res, t_lock = run.result, run.summary["engagement_time_s"]
+    assert res["h_1_m"][-1] == pytest.approx(res["h_2_m"][-1], rel=1e-6)
+    slip = res.t < t_lock
+    viscous, total = res["viscous_torque_Nm"][slip], res["total_torque_Nm"][slip]
+    peak = int(np.argmax(viscous))
+    assert 0 < peak and viscous[-1] < 5e-3 * viscous[peak]
+    assert total[-1] > 1.3 * total[peak:].min()

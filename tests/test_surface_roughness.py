@@ -77,4 +77,17 @@ def test_a_rough_lining_on_a_smooth_separator_lowers_the_viscous_peak():
     lining = simulate_engagement(load_scene("zhang2021"), **grid).summary
     assert equal["peak_torque_Nm"] == pytest.approx(613, rel=5e-3)
     assert lining["peak_torque_Nm"] == pytest.approx(255, rel=5e-3)
-    assert np.isclose(lining["stable_torque_Nm"], equal["stable_torque_Nm"], rtol=1e-9)   # the axial side is untouched
+    # the axial side is untouched: the same equations, equal to the integration tolerance (rtol 1e-8)
+    assert np.isclose(lining["stable_torque_Nm"], equal["stable_torque_Nm"], rtol=1e-7)
+
+
+def test_the_viscous_torque_of_one_rough_surface_is_continuous_at_the_phi_fs_cutoff():
+    """Cui Eq. 8 cuts Phi_fs to 0 above H = 7, a jump of 0.0127 against phi_f = 1.02: the film law
+    uses the smooth cut, so the torque is continuous there (exact cut: a 1.2 % step), and equals the
+    exact form to 5e-5 below H = 6.5 and 1e-6 (absolute, in phi_fs) above 7.5."""
+    film = FilmLaw(load_scene("zhang2021"))
+    below, above = float(film.viscous_torque(7 * SIGMA * (1 - 1e-9), 1000.0)), float(film.viscous_torque(7 * SIGMA * (1 + 1e-9), 1000.0))
+    assert below == pytest.approx(above, rel=1e-7)
+    for H, tol in ((6.5, 5e-5), (7.5, 1e-6)):
+        exact = hand_viscous_torque(film, H * SIGMA, 1000.0, patir_cheng_Phi_fs(H) if H <= 7 else 0.0)
+        assert float(film.viscous_torque(H * SIGMA, 1000.0)) == pytest.approx(exact, rel=tol)

@@ -162,10 +162,14 @@ class FilmLaw:
         return table(_clamp(p, pressures[0], pressures[-1]))
 
     def viscous_torque(self, h, w_rel):
-        """Viscous shear torque of the film [N m], same sign as w_rel (Cui Eq. 9)."""
+        """Viscous shear torque of the film [N m], same sign as w_rel (Cui Eq. 9).
+
+        phi_fs is cut off smoothly at H = 7 (the exact cut is a jump of the torque once the two
+        surfaces differ in roughness; see :func:`clutchocp.physics.shear.viscous_torque`).
+        """
         return shear.viscous_torque(w_rel, h, self.eta, self.r1, self.r2, sigma_1=self.sigma_1,
                                     sigma_2=self.sigma_2, area_ratio=self.area_ratio(h),
-                                    land_fraction=self.land_fraction, smooth=self.smooth)
+                                    land_fraction=self.land_fraction, smooth=self.smooth, smooth_cutoff=True)
 
     def contact_torque(self, h, w_rel, direction):
         """Asperity friction torque [N m] while slipping in ``direction`` (+1 or -1) (Bao Eq. 25)."""

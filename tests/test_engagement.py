@@ -114,18 +114,24 @@ def test_energy_accumulators_only_for_the_parts_a_scene_has():
 @pytest.mark.parametrize("name", ["zhang2021", "bao2020"])
 def test_event_times_converge_as_tolerances_tighten(name):
     """Each event's error against a reference at rtol 1e-11 shrinks tenfold or more per two decades
-    of tolerance (measured on zhang2021 lock-up: 6.8e-6, 3.2e-7, 4.2e-9 s; bao2020 lock-up: 7.9e-6,
-    9.8e-9, 1.6e-10 s)."""
+    of tolerance. The error of one run changes sign from tolerance to tolerance, so a single run can
+    sit near a zero crossing (zhang2021 lock-up at rtol 1e-5: 1.0e-7, at 3e-5: 8.5e-6); the error of
+    a tolerance step is therefore the larger of the runs at rtol and 3 rtol. Measured (relative):
+    zhang2021 8.5e-6, 1.8e-8, 6.6e-10; bao2020 3.0e-4, 6.0e-7, 2.9e-8; at rtol 1e-9 alone 6.6e-10 and
+    2.5e-9."""
     scene = load_scene(name)
     model = EngagementModel(scene)
     reference = {e.name: e.t for e in simulate_engagement(scene, model=model, rtol=1e-11, atol=1e-13).result.events}
-    errors = []
-    for tol in (1e-5, 1e-7, 1e-9):
+
+    def error(tol):
         run = simulate_engagement(scene, model=model, rtol=tol, atol=tol * 1e-2)
         assert [e.name for e in run.result.events] == list(reference)
-        errors.append(max(abs(e.t - reference[e.name]) / reference[e.name] for e in run.result.events))
+        return max(abs(e.t - reference[e.name]) / reference[e.name] for e in run.result.events)
+
+    single = {tol: error(tol) for tol in (1e-5, 1e-7, 1e-9)}
+    errors = [max(single[tol], error(3 * tol)) for tol in (1e-5, 1e-7, 1e-9)]
     assert errors[1] <= 0.1 * errors[0] and errors[2] <= 0.1 * errors[1], errors
-    assert errors[2] <= 1e-8
+    assert single[1e-9] <= 1e-8
 
 
 # Measured IDAS steps at the scene tolerances (rtol 1e-8, atol 1e-10) when written; the caps are
@@ -207,8 +213,10 @@ def test_lockup_torque_jump_is_the_torque_difference_of_the_event(runs, name):
     w_rel = w_in - w_out
     assert abs(w_rel) <= 1e-6 * max(abs(w_in), 1.0)          # located at w_rel = 0
     film = model.film
+    # the films that drive the output: all, or the first only (driveline.driving_films, Bao Eq. 26)
+    driving = 1 if scene.get("driveline.driving_films") == "first" else model.n
     slipping = sum(float(film.viscous_torque(x[f"h_{i + 1}"], w_rel)) + float(film.contact_torque(x[f"h_{i + 1}"], w_rel, 1.0))
-                   for i in range(model.n))
+                   for i in range(driving))
     assert before == pytest.approx(slipping, rel=1e-9)
     T_in = scene.get("driveline.input_torque", 0.0) if model.input_inertia else 0.0
     T_load = scene.value("load.torque") if scene.variant("load") == "constant" else 0.0

@@ -3,6 +3,14 @@
 Every film of a scene has the same plates, oil and roughness, so one ``FilmLaw`` serves all of
 them; it publishes, for a film of thickness h, the load W = K (-dh/dt) + S carried by the film
 (fluid + asperities) and the torque it transmits at a relative speed w_rel.
+
+How the fluid and the asperities share the load is a model-form choice (``film.load_sharing``):
+
+* ``"reduced"`` (default): the fluid pressure acts on the free area only, W = (1 - A_c/A_n) W_fluid
+  + p_c A_n (Bao Eq. 12 and 27; Zhang Eq. 8 writes the same split with delta = A_c/A_n);
+* ``"additive"``: the averaged Reynolds pressure is already a mean over the nominal area (Patir and
+  Cheng's flow factors account for the asperities), so W = W_fluid + p_c A_n, the form of most
+  mixed-lubrication engagement models.
 """
 
 import math
@@ -45,9 +53,12 @@ class FilmLaw:
         self.flow_factor = scene.get("film.flow_factor", "patir_cheng")
         self.centrifugal = scene.get("film.centrifugal", False)
         self.inlet_pressure = scene.get("film.inlet_pressure", 0.0)
+        self.load_sharing = scene.get("film.load_sharing", "reduced")
         self.sigma = scene.value("roughness.sigma")
-        # With only the combined roughness known, both surfaces are taken equally rough, which
-        # makes the Patir-Cheng shear factor phi_fs (Cui Eq. 7, V_r1 - V_r2) vanish.
+        # Per surface: sigma_1 of the friction plate (lining), sigma_2 of the separator; they set the
+        # Patir-Cheng shear factor phi_fs (Cui Eq. 7: V_r1 - V_r2). The pressure flow factor phi_r
+        # of isotropic roughness (gamma = 1) and the contact laws depend on the combined sigma only.
+        # With only the combined roughness known, both surfaces are taken equally rough (phi_fs = 0).
         self.sigma_1 = scene.get("roughness.sigma_1", self.sigma / math.sqrt(2))
         self.sigma_2 = scene.get("roughness.sigma_2", self.sigma / math.sqrt(2))
         self.n_a = scene.get("roughness.asperity_density")
@@ -58,6 +69,7 @@ class FilmLaw:
                              "greenwood_tripp, zhang_gw or none")
         self.E = scene.get("contact.E_equiv")
         self.fit = scene.get("contact.fit", "exact")
+        self.contact_force_form = scene.get("contact.force", "nominal")
         self.n0 = scene.get("contact.area_factor", 1.0)
         self.friction_model = scene.variant("friction")
         self.scene = scene
@@ -87,10 +99,13 @@ class FilmLaw:
             return 0.0
         H = h / self.sigma
         if self.contact_model == "greenwood_tripp":
-            # Greenwood-Tripp: nominal asperity pressure K' E' F_5/2(H). Bao Eq. 20 multiplies it once
-            # more by the area ratio C; that double-counts the contact area and is not followed.
+            # Greenwood-Tripp: nominal asperity pressure K' E' F_5/2(H), over the nominal area. Bao
+            # Eq. 20 multiplies it once more by the area ratio C (contact.force = "area_ratio", kept
+            # to reproduce Bao as published); that double-counts the contact area.
             p_c = contact.greenwood_tripp_pressure(H, self.E, self.n_a, self.beta, self.sigma,
                                                    fit=self.fit, smooth=self.smooth)
+            if self.contact_force_form == "area_ratio":
+                return self.area_ratio(h) * p_c * self.area                              # Bao Eq. 20
             return p_c * self.area
         # Zhang Eq. 6 and 8: pressure E*delta on the real area delta*A_n.
         delta = contact.zhang_area_ratio(H, self.n_a, self.beta, self.sigma)
@@ -98,7 +113,19 @@ class FilmLaw:
 
     # -- axial load ---------------------------------------------------------------------------
     def load_coefficients(self, h, w_in, w_out):
-        """(K, S) with film load W = K (-dh/dt) + S [N s/m, N], fluid on the non-contact area + asperities."""
+        """Film load W = K (-dh/dt) + S: fluid (shared as ``film.load_sharing`` says) + asperities.
+
+        Parameters
+        ----------
+        h : float or CasADi symbol
+            Nominal film thickness [m].
+        w_in, w_out : float or CasADi symbol
+            Speeds of the two plates [rad/s] (used by the centrifugal term only).
+
+        Returns
+        -------
+        (K, S) : squeeze coefficient [N s/m] and static load [N].
+        """
         phi_r = 1.0
         if self.flow_factor == "patir_cheng" and self.sigma > 0:
             phi_r = squeeze_film.pressure_flow_factor(h / self.sigma, smooth=self.smooth)
@@ -110,7 +137,10 @@ class FilmLaw:
         # The load is linear in dh_T/dt; dh_T/dt = Phi(H) dh/dt (Bao Eq. 10).
         per_rate = squeeze_film.film_load(h, -1.0, self.eta, self.r1, self.r2, **kw) - static
         gap_rate = roughness.average_gap_derivative(h, self.sigma) if self.sigma > 0 else 1.0
-        fluid_share = 1.0 - self.area_ratio(h)          # Bao Eq. 12, Zhang Eq. 8: fluid on A_n - A_c
+        if self.load_sharing == "reduced":
+            fluid_share = 1.0 - self.area_ratio(h)      # Bao Eq. 12, Zhang Eq. 8: fluid on A_n - A_c
+        else:
+            fluid_share = 1.0                           # fluid on the whole nominal area, plus p_c A_n
         return fluid_share * per_rate * gap_rate, fluid_share * static + self.contact_force(h)
 
     # -- torque -------------------------------------------------------------------------------
@@ -132,10 +162,14 @@ class FilmLaw:
         return table(_clamp(p, pressures[0], pressures[-1]))
 
     def viscous_torque(self, h, w_rel):
-        """Viscous shear torque of the film [N m], same sign as w_rel (Cui Eq. 9)."""
+        """Viscous shear torque of the film [N m], same sign as w_rel (Cui Eq. 9).
+
+        phi_fs is cut off smoothly at H = 7 (the exact cut is a jump of the torque once the two
+        surfaces differ in roughness; see :func:`clutchocp.physics.shear.viscous_torque`).
+        """
         return shear.viscous_torque(w_rel, h, self.eta, self.r1, self.r2, sigma_1=self.sigma_1,
                                     sigma_2=self.sigma_2, area_ratio=self.area_ratio(h),
-                                    land_fraction=self.land_fraction, smooth=self.smooth)
+                                    land_fraction=self.land_fraction, smooth=self.smooth, smooth_cutoff=True)
 
     def contact_torque(self, h, w_rel, direction):
         """Asperity friction torque [N m] while slipping in ``direction`` (+1 or -1) (Bao Eq. 25)."""

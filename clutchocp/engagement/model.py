@@ -68,6 +68,7 @@ class EngagementModel:
         self.film = FilmLaw(scene, smooth=smooth)
         self.actuation = Actuation(scene, command=pressure_command)
         self.n = scene.value("plates.n_interfaces")
+        self.n_driving = 1 if scene.get("driveline.driving_films", "all") == "first" else self.n
         self.H0 = scene.value("pack.initial_gap")
         self.sigma = self.film.sigma if self.film.sigma > 0 else self.H0 / 10
         self.has_piston = scene.has("piston")
@@ -231,10 +232,14 @@ class EngagementModel:
         h = [self.state(f"h_{i + 1}") for i in range(n)]
         K, S = zip(*(film.load_coefficients(hi, w_in, w_clutch) for hi in h))
         direction = {"slip_forward": 1.0, "slip_reverse": -1.0, "locked": 0.0}[rotation]
-        T_visc = [film.viscous_torque(hi, w_rel) for hi in h]
-        T_cont = [film.contact_torque(hi, w_rel, direction) for hi in h]
+        # Films that transmit torque: all of them, or only the first (Bao Eq. 26 as printed); the
+        # others still carry axial load.
+        driving = h[:self.n_driving]
+        idle = [0.0] * (n - self.n_driving)
+        T_visc = [film.viscous_torque(hi, w_rel) for hi in driving] + idle
+        T_cont = [film.contact_torque(hi, w_rel, direction) for hi in driving] + idle
         T_film = [tv + tc for tv, tc in zip(T_visc, T_cont)]
-        capacity = sum(film.static_capacity(hi) for hi in h)
+        capacity = sum(film.static_capacity(hi) for hi in driving)
         seal_power = 0.0
         hydraulic_power = 0.0
         spline_power = 0.0

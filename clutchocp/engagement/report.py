@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 
 from ..output import new_figure, save_figure, write_csv, write_summary
+from .run import pressure_rise_time
 
 
 def write_engagement(run, out_dir):
@@ -71,7 +72,44 @@ def plot_engagement(run, out):
     ax.plot(t, res["pressure_Pa"] / 1e6)
     ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{name}: engagement pressure")
     files.append(_finish(fig, ax, run, out / "pressure.png", legend=False))
+    if run.summary["torque_response_time_stable_s"] is not None:
+        files.append(plot_torque_response(run, out / "torque_response.png"))
     return files
+
+
+def plot_torque_response(run, path):
+    """Zhang's torque response: the torques from the start to a few response times past 50 % pressure,
+    with the stable torque, its 90 % level and the end of both response times marked."""
+    res, model, summary = run.result, run.model, run.summary
+    t50 = pressure_rise_time(model, res, 0.5)
+    stable = summary["stable_torque_Nm"]
+    ends = {"stable": t50 + summary["torque_response_time_stable_s"]}
+    if summary["torque_response_time_s"] is not None:
+        ends["peak"] = t50 + summary["torque_response_time_s"]
+    t_show = min(res.t[-1], t50 + 3 * (max(ends.values()) - t50))
+    keep = res.t <= t_show
+    t = res.t[keep]
+    fig, (ax,) = new_figure(width=7.4, height=4.6)
+    ax.plot(t, np.abs(res["viscous_torque_Nm"][keep]), label="viscous")
+    ax.plot(t, np.abs(res["contact_torque_Nm"][keep]), label="asperity contact")
+    ax.plot(t, np.abs(res["total_torque_Nm"][keep]), "k--", lw=1.2, label="total")
+    ax.axhline(stable, color="C3", ls="--", lw=0.8, label=f"stable torque {stable:.4g} N m")
+    ax.axhline(0.9 * stable, color="C3", ls=":", lw=0.8, label="90 % of the stable torque")
+    ax.axvline(t50, color="0.5", lw=0.8, label=f"50 % of set pressure, {t50 * 1e3:.1f} ms")
+    ax.axvline(ends["stable"], color="C3", lw=1.2,
+               label=f"to 90 % stable: {summary['torque_response_time_stable_s'] * 1e3:.1f} ms (Zhang)")
+    if "peak" in ends:
+        ax.axvline(ends["peak"], color="C4", lw=1.2,
+                   label=f"to 90 % of the peak: {summary['torque_response_time_s'] * 1e3:.1f} ms")
+    pressure_axis = ax.twinx()
+    pressure_axis.plot(t, res["pressure_Pa"][keep] / 1e6, color="0.6", lw=0.8)
+    pressure_axis.set_ylabel("pressure [MPa] (grey)")
+    ax.set_zorder(pressure_axis.get_zorder() + 1)      # torques and legend above the pressure curve
+    ax.patch.set_visible(False)
+    ax.set(xlabel="time [s]", ylabel="clutch torque [N m]",
+           title=f"{model.scene.name}: torque response from 50 % pressure")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.12, 1.0), borderaxespad=0)
+    return save_figure(fig, path)
 
 
 def format_summary(summary):
@@ -86,6 +124,8 @@ def format_summary(summary):
         f"  lock-up torque jump         {num('lockup_torque_jump_Nm', 'N m')}",
         f"  peak torque                 {num('peak_torque_Nm', 'N m')}",
         f"  peak output jerk            {num('peak_jerk_rad_s3', 'rad/s^3')}",
+        f"  torque response (Zhang)     {num('torque_response_time_stable_s', 's')} to 90 % of the stable "
+        f"{num('stable_torque_Nm', 'N m')}; {num('torque_response_time_s', 's')} to 90 % of the peak",
         f"  dissipated energy           {num('dissipated_energy_J', 'J')}",
         f"  energy balance error        {num('energy_balance_rel_error', '(relative)', '{:.2e}')}",
         f"  wall time                   {num('wall_time_s', 's', '{:.3f}')}",

@@ -310,7 +310,12 @@ class Scene:
         return self._values.get(part, {}).get(key, default)
 
     def with_overrides(self, overrides):
-        """A new scene with ``{"part.key": value}`` replaced (values as in a scene file; None removes the key)."""
+        """A new scene with ``{"part.key": value}`` replaced (values as in a scene file; None removes the key).
+
+        ``roughness.sigma`` (the combined RMS) on a scene that gives the roughness per surface scales
+        ``sigma_1`` and ``sigma_2`` to the new combined value, keeping their ratio.
+        """
+        overrides = _split_combined_roughness(self, overrides)
         raw = {part: dict(table) if isinstance(table, dict) else table for part, table in self.raw.items()}
         for name, value in overrides.items():
             part, dot, key = name.partition(".")
@@ -332,6 +337,23 @@ class Scene:
 
     def __repr__(self):
         return f"Scene({self.name!r}, kind={self.kind!r}, parts={list(self.parts)})"
+
+
+def _split_combined_roughness(scene, overrides):
+    """Overrides with a combined ``roughness.sigma`` turned into ``sigma_1``/``sigma_2`` of the same ratio,
+    where the scene gives the roughness per surface (and the overrides do not set them)."""
+    per_surface = ("roughness.sigma_1", "roughness.sigma_2")
+    if (overrides.get("roughness.sigma") is None or any(k in overrides for k in per_surface)
+            or scene.get("roughness.sigma_1") is None or scene.get("roughness.sigma_2") is None):
+        return overrides
+    sigma = _parse_field("roughness.sigma", overrides["roughness.sigma"], PARTS["roughness"].fields["sigma"])
+    scale = sigma / scene.value("roughness.sigma") if scene.value("roughness.sigma") > 0 else None
+    if scale is None:
+        raise SceneError("roughness.sigma: this scene gives sigma_1 = sigma_2 = 0; set roughness.sigma_1 and "
+                         "roughness.sigma_2 instead")
+    out = {k: v for k, v in overrides.items() if k != "roughness.sigma"}
+    out.update({k: scene.value(k) * scale for k in per_surface})
+    return out
 
 
 def validate(raw, base_dir):

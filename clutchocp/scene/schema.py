@@ -128,6 +128,10 @@ PARTS = {
             "centrifugal": Field(kind="bool", required=False, default=False,
                                  doc="include the centrifugal term (Bao Eq. 11)"),
             "inlet_pressure": QOpt("Pa", 0.0, doc="oil pressure at the inner radius [Pa]"),
+            "load_sharing": Field(kind="choice", choices=("reduced", "additive"), required=False,
+                                  default="reduced",
+                                  doc="fluid load on the free area (1 - A_c/A_n) W_fluid + p_c A_n (Bao Eq. 12, "
+                                      "'reduced') or the full W_fluid + p_c A_n ('additive')"),
         },
     ),
     "roughness": Part(
@@ -152,6 +156,9 @@ PARTS = {
                 "fit": Field(kind="choice", choices=("exact", "patir"), required=False,
                              default="exact", doc="F_5/2 exact or Bao Eq. 19 fit"),
                 "area_factor": QOpt("1", 1.0, "area_factor", "elastoplastic area factor n0"),
+                "force": Field(kind="choice", choices=("nominal", "area_ratio"), required=False,
+                               default="nominal",
+                               doc="asperity force p_c A_n ('nominal') or Bao Eq. 20's C p_c A_n ('area_ratio')"),
                 "hardness": QOpt("Pa", None, "positive", "hardness H' [Pa]"),
             },
             "zhang_gw": {"E_equiv": Q("Pa", doc="equivalent elastic modulus E [Pa]")},
@@ -288,6 +295,9 @@ PARTS = {
             "output_speed": QOpt("rad/s", 0.0, "nonnegative", "initial output speed [rad/s]"),
             "shaft_stiffness": QOpt("N m", None, "positive", "output-shaft torsional stiffness [N m/rad]"),
             "shaft_damping": QOpt("N m s", 0.0, doc="output-shaft torsional damping [N m s/rad]"),
+            "driving_films": Field(kind="choice", choices=("all", "first"), required=False, default="all",
+                                   doc="films whose torque acts between input and output: all, or only the "
+                                       "first (Bao Eq. 26 as printed)"),
         },
     ),
     "load": Part(

@@ -208,6 +208,7 @@ def _cross_check(values, base_dir):
             _require(values, f"roughness.{key}", f"by contact model '{contact}'")
         if values["roughness"]["sigma"] <= 0:
             raise PhysicalRangeError(f"roughness.sigma = 0: must be > 0 with contact model '{contact}'")
+    _check_temperatures(values)
     friction = values.get("friction", {})
     if friction.get("model") == "table":
         p, mu = friction["pressure"], friction["mu"]
@@ -242,6 +243,41 @@ def _cross_check(values, base_dir):
     piston = values.get("piston")
     if piston is not None and piston["model"] == "spring_applied" and piston["spring_stiffness"] <= 0:
         raise PhysicalRangeError("piston.spring_stiffness: must be > 0 for a spring-applied piston")
+
+
+def _check_temperatures(values):
+    """The [thermal] part, the Walther oil and Chen's friction law: each temperature given once.
+
+    A Walther oil gets its derived ``oil.viscosity`` [Pa s] at the oil temperature, for the parts
+    that read a constant viscosity (piston seal, HVD and static analyses).
+    """
+    thermal, oil, friction = values.get("thermal"), values.get("oil", {}), values.get("friction", {})
+    if thermal is not None:
+        if values["scene"]["kind"] != "engagement":
+            raise SceneError("[thermal]: plate temperatures are modelled for engagement scenes only")
+        thermal.setdefault("initial_temperature_C", thermal["oil_temperature_C"])
+    if friction.get("model") == "chen2021":
+        if thermal is not None and "temperature_C" in friction:
+            raise SceneError("friction.temperature_C: not used with a [thermal] part (Chen's law reads the "
+                             "interface temperature); remove it")
+        if thermal is None and "temperature_C" not in friction:
+            raise MissingParameterError("friction.temperature_C: missing, required by friction.model = 'chen2021' "
+                                        "without a [thermal] part")
+    if oil.get("model") != "walther":
+        return
+    if thermal is not None and "temperature_C" in oil:
+        raise SceneError("oil.temperature_C: with a [thermal] part the oil temperature is "
+                         "thermal.oil_temperature_C; remove oil.temperature_C")
+    if thermal is None and "temperature_C" not in oil:
+        raise MissingParameterError("oil.temperature_C: missing, required by oil.model = 'walther' without a "
+                                    "[thermal] part")
+    from ..physics.viscosity import walther_coefficients, walther_kinematic_viscosity
+    try:
+        A, B = walther_coefficients(40.0, oil["kinematic_viscosity_40C"], 100.0, oil["kinematic_viscosity_100C"])
+    except PhysicalRangeError as exc:
+        raise PhysicalRangeError(f"oil.kinematic_viscosity_40C, oil.kinematic_viscosity_100C: {exc}") from None
+    theta = thermal["oil_temperature_C"] if thermal is not None else oil["temperature_C"]
+    oil["viscosity"] = oil["density"] * float(walther_kinematic_viscosity(theta, A, B))
 
 
 class Scene:

@@ -97,7 +97,8 @@ def _cmd_optimize(args):
     run_optimize(args.scene, out_dir=args.out, t_max=args.t_max,
                  weights=_parse_weights(args.weights) if args.weights else None,
                  intervals=args.intervals, degree=args.degree,
-                 sweep_t_max=_parse_sweep(args.sweep_t_max) if args.sweep_t_max else None)
+                 sweep_t_max=_parse_sweep(args.sweep_t_max) if args.sweep_t_max else None,
+                 max_temperature_C=args.max_temperature, max_specific_power_W_mm2=args.max_specific_power)
     return 0
 
 
@@ -144,6 +145,10 @@ def build_parser():
     p.add_argument("--degree", type=int, default=3, help="collocation points per interval (default: 3)")
     p.add_argument("--sweep-t-max", default=None, metavar="LIST|START:STOP:COUNT",
                    help="solve for several engagement-time limits and draw the jerk/time trade-off")
+    p.add_argument("--max-temperature", type=float, default=None, metavar="DEGC",
+                   help="largest interface temperature [degC] while slipping (scene needs a [thermal] part)")
+    p.add_argument("--max-specific-power", type=float, default=None, metavar="W_MM2",
+                   help="largest interface heat power per friction area [W/mm^2] while slipping")
     p.set_defaults(run=_cmd_optimize)
     p = sub.add_parser("bench", help="error against run time, stiffness and scaling (work-precision report)")
     p.add_argument("--quick", action="store_true", help="fewer tolerances and sizes (under 3 minutes)")

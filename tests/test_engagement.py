@@ -4,7 +4,6 @@ closed forms, a second integrator, limits and solver statistics on the scenes in
 import math
 
 import casadi as ca
-
 import numpy as np
 import pytest
 

@@ -21,6 +21,7 @@ from ..errors import (
     UnknownKeyError,
     UnknownVariantError,
 )
+from ..physics.viscosity import walther_coefficients, walther_kinematic_viscosity
 from ..units import to_si
 from .schema import CHECKS, PARTS, REQUIRED_PARTS
 
@@ -257,27 +258,25 @@ def _check_temperatures(values):
             raise SceneError("[thermal]: plate temperatures are modelled for engagement scenes only")
         thermal.setdefault("initial_temperature_C", thermal["oil_temperature_C"])
     if friction.get("model") == "chen2021":
-        if thermal is not None and "temperature_C" in friction:
-            raise SceneError("friction.temperature_C: not used with a [thermal] part (Chen's law reads the "
-                             "interface temperature); remove it")
-        if thermal is None and "temperature_C" not in friction:
-            raise MissingParameterError("friction.temperature_C: missing, required by friction.model = 'chen2021' "
-                                        "without a [thermal] part")
+        _fixed_temperature("friction", friction, thermal is not None, "Chen's law reads the interface temperature")
     if oil.get("model") != "walther":
         return
-    if thermal is not None and "temperature_C" in oil:
-        raise SceneError("oil.temperature_C: with a [thermal] part the oil temperature is "
-                         "thermal.oil_temperature_C; remove oil.temperature_C")
-    if thermal is None and "temperature_C" not in oil:
-        raise MissingParameterError("oil.temperature_C: missing, required by oil.model = 'walther' without a "
-                                    "[thermal] part")
-    from ..physics.viscosity import walther_coefficients, walther_kinematic_viscosity
+    _fixed_temperature("oil", oil, thermal is not None, "the oil temperature is thermal.oil_temperature_C")
     try:
         A, B = walther_coefficients(40.0, oil["kinematic_viscosity_40C"], 100.0, oil["kinematic_viscosity_100C"])
     except PhysicalRangeError as exc:
         raise PhysicalRangeError(f"oil.kinematic_viscosity_40C, oil.kinematic_viscosity_100C: {exc}") from None
     theta = thermal["oil_temperature_C"] if thermal is not None else oil["temperature_C"]
     oil["viscosity"] = oil["density"] * float(walther_kinematic_viscosity(theta, A, B))
+
+
+def _fixed_temperature(part, table, has_thermal, with_thermal):
+    """``<part>.temperature_C``, a law's fixed temperature: required without [thermal], refused with it."""
+    if has_thermal and "temperature_C" in table:
+        raise SceneError(f"{part}.temperature_C: not used with a [thermal] part ({with_thermal}); remove it")
+    if not has_thermal and "temperature_C" not in table:
+        raise MissingParameterError(f"{part}.temperature_C: missing, required by {part}.model = '{table['model']}' "
+                                    "without a [thermal] part")
 
 
 class Scene:

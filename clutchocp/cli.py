@@ -65,6 +65,25 @@ def _cmd_simulate(args):
     return 0
 
 
+def _cmd_cycles(args):
+    from tqdm import tqdm
+
+    from .engagement.cycles import format_cycles, run_cycles, write_cycles
+    from .scene import load_scene, parse_override
+
+    scene = load_scene(args.scene, overrides=dict(parse_override(text) for text in args.set))
+    with tqdm(total=args.cycles, desc="engagements", unit="cycle", file=sys.stderr) as bar:
+        def step(row):
+            bar.update(1)
+            bar.set_postfix_str(f"peak {row['peak_interface_temperature_C']:.1f} degC")
+        result = run_cycles(scene, cycles=args.cycles, cooling_time=args.cooling_time,
+                            max_temperature_C=args.max_temperature, progress=step)
+    print(format_cycles(result))
+    files = write_cycles(result, args.out)
+    print(f"wrote {len(files)} files to {args.out}: {', '.join(f.name for f in files)}")
+    return 0
+
+
 def _cmd_control(args):
     from .hvd.report import run_control
 
@@ -104,7 +123,8 @@ def _cmd_optimize(args):
     run_optimize(args.scene, out_dir=args.out, t_max=args.t_max,
                  weights=_parse_weights(args.weights) if args.weights else None,
                  intervals=args.intervals, degree=args.degree,
-                 sweep_t_max=_parse_sweep(args.sweep_t_max) if args.sweep_t_max else None)
+                 sweep_t_max=_parse_sweep(args.sweep_t_max) if args.sweep_t_max else None,
+                 max_temperature_C=args.max_temperature, max_specific_power_W_mm2=args.max_specific_power)
     return 0
 
 
@@ -141,6 +161,18 @@ def build_parser():
     p.add_argument("--native", action="store_true",
                    help="compile the equations to C with the system compiler first (faster repeated runs)")
     p.set_defaults(run=_cmd_simulate)
+    p = sub.add_parser("cycles", help="repeated engagements with cooling between: temperature and engagement-time "
+                                      "drift per cycle, until a limit (scene needs a [thermal] part)")
+    p.add_argument("scene", help="engagement scene with a [thermal] part (e.g. default_driveline_thermal) or TOML file")
+    p.add_argument("--cycles", type=int, default=10, help="largest number of engagements (default: 10)")
+    p.add_argument("--cooling-time", type=float, default=10.0, metavar="S",
+                   help="open-clutch cooling interval after each engagement run [s] (default: 10)")
+    p.add_argument("--max-temperature", type=float, default=None, metavar="DEGC",
+                   help="stop after the cycle whose peak interface temperature reaches this [degC]")
+    p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
+                   help="override a scene value (repeatable)")
+    p.add_argument("--out", default="out/cycles", help="output folder (default: out/cycles)")
+    p.set_defaults(run=_cmd_cycles)
     p = sub.add_parser("optimize", help="optimal engagement pressure by direct collocation (the main job)")
     p.add_argument("scene", nargs="?", default=None, help="engagement scene (default: the default scene)")
     p.add_argument("--out", default="out/optimize", help="output folder (default: out/optimize)")
@@ -151,6 +183,10 @@ def build_parser():
     p.add_argument("--degree", type=int, default=3, help="collocation points per interval (default: 3)")
     p.add_argument("--sweep-t-max", default=None, metavar="LIST|START:STOP:COUNT",
                    help="solve for several engagement-time limits and draw the jerk/time trade-off")
+    p.add_argument("--max-temperature", type=float, default=None, metavar="DEGC",
+                   help="largest interface temperature [degC] while slipping (scene needs a [thermal] part)")
+    p.add_argument("--max-specific-power", type=float, default=None, metavar="W_MM2",
+                   help="largest interface heat power per friction area [W/mm^2] while slipping")
     p.set_defaults(run=_cmd_optimize)
     p = sub.add_parser("bench", help="error against run time, stiffness and scaling (work-precision report)")
     p.add_argument("--quick", action="store_true", help="fewer tolerances and sizes (under 3 minutes)")

@@ -14,7 +14,7 @@ from .errors import UnitError
 
 # Dimension vectors: (kg, m, s, K).
 _DIMENSIONLESS = (0, 0, 0, 0)
-_KG, _M, _S = (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0)
+_KG, _M, _S, _K = (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1)
 
 
 def _combine(*pairs):
@@ -45,6 +45,8 @@ _UNITS = {
     "rpm": (2 * math.pi / 60.0, _combine((_S, -1))),
     "Hz": (1.0, _combine((_S, -1))),
     "cP": (1e-3, _combine((_PA, 1), (_S, 1))),
+    "cSt": (1e-6, _combine((_M, 2), (_S, -1))),
+    "K": (1.0, _K),
     "L": (1e-3, _combine((_M, 3))),
     "percent": (0.01, _DIMENSIONLESS), "%": (0.01, _DIMENSIONLESS),
     "1": (1.0, _DIMENSIONLESS),
@@ -62,6 +64,8 @@ DIMENSIONS = {
     "Pa": _PA, "Pa s": _combine((_PA, 1), (_S, 1)), "kg/m^3": _combine((_KG, 1), (_M, -3)),
     "kg m^2": _combine((_KG, 1), (_M, 2)), "J": _J, "W": _W, "m/s": _combine((_M, 1), (_S, -1)),
     "rad": _DIMENSIONLESS,
+    "m^2/s": _combine((_M, 2), (_S, -1)), "J/K": _combine((_J, 1), (_K, -1)),
+    "W/m^2/K": _combine((_W, 1), (_M, -2), (_K, -1)),
 }
 
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")

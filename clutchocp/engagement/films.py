@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import ModelError
 from ..physics import contact, friction, roughness, shear, squeeze_film
 from ..physics.backend import fmin
+from ..physics.viscosity import OilViscosity
 
 # Chen 2021 Eq. 5 is singular below 25 kPa and fitted for 0.2-2 MPa; Cui Eq. 18 is fitted for
 # 0.1-1 MPa. Outside, the pressure fed to the law is clamped to the fitted range.
@@ -37,15 +38,19 @@ class FilmLaw:
         An engagement scene (plates, oil, film, roughness, contact, friction parts).
     smooth : bool
         Use the smooth forms of the switching laws (for optimisation).
+    temperature : casadi.SX, optional
+        Interface temperature [deg C] published by the thermal part; the viscosity and Chen's
+        friction law follow it. None: the scene's fixed temperatures.
     """
 
-    def __init__(self, scene, smooth=False):
+    def __init__(self, scene, smooth=False, temperature=None):
         self.smooth = smooth
         self.r1 = scene.value("plates.r_inner")
         self.r2 = scene.value("plates.r_outer")
         self.area = math.pi * (self.r2**2 - self.r1**2)
         self.r_eff = contact.effective_radius(self.r1, self.r2, rule="bao")  # Bao Eq. 25-26
-        self.eta = scene.value("oil.viscosity")
+        self.eta = OilViscosity(scene).dynamic(temperature) if temperature is not None else scene.value("oil.viscosity")
+        self.temperature_C = temperature if temperature is not None else scene.get("friction.temperature_C")
         self.rho = scene.value("oil.density")
         self.land_fraction = scene.value("plates.land_fraction")
         self.permeability = scene.value("plates.lining_permeability")
@@ -75,7 +80,7 @@ class FilmLaw:
         self.scene = scene
         self.mu_static = scene.get("friction.static_coefficient")
         if self.mu_static is None:
-            self.mu_static = float(self.mu(0.0, 0.5e6))
+            self.mu_static = float(self.mu(0.0, 0.5e6, theta=100.0))   # Chen Eq. 5 at v = 0 does not depend on theta
 
     # -- asperities ---------------------------------------------------------------------------
     def area_ratio(self, h):
@@ -144,8 +149,9 @@ class FilmLaw:
         return fluid_share * per_rate * gap_rate, fluid_share * static + self.contact_force(h)
 
     # -- torque -------------------------------------------------------------------------------
-    def mu(self, v, p):
-        """Asperity friction coefficient at slip speed v [m/s] and nominal contact pressure p [Pa]."""
+    def mu(self, v, p, theta=None):
+        """Asperity friction coefficient at slip speed v [m/s], nominal contact pressure p [Pa] and
+        temperature theta [deg C] (default: the interface temperature; only Chen's law reads it)."""
         model, s = self.friction_model, self.scene
         if model == "constant":
             return s.value("friction.mu")
@@ -153,7 +159,8 @@ class FilmLaw:
             return friction.mu_stribeck(v, s.value("friction.mu_static"), s.value("friction.mu_kinetic"),
                                         s.value("friction.v_stribeck"), smooth=self.smooth)
         if model == "chen2021":
-            return friction.mu_chen2021(v, _clamp(p, *_CHEN_P_RANGE), s.value("friction.temperature_C"),
+            theta = self.temperature_C if theta is None else theta
+            return friction.mu_chen2021(v, _clamp(p, *_CHEN_P_RANGE), theta,
                                         smooth=self.smooth)
         if model == "cui2019":
             return friction.mu_cui2019(_clamp(p, *_CUI_P_RANGE))

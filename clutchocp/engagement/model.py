@@ -10,9 +10,11 @@ shape); a part that the scene does not declare adds no state:
     w_in              input speed                              (driveline.input = "inertia")
     w_out             output speed                             (driveline.output = "inertia")
     theta_shaft       output shaft twist                       (driveline.shaft_stiffness given)
+    T_friction, T_separator  plate temperatures [degC]         (a [thermal] part)
     E_*               energy accumulators for the balance check: source, hydraulic, slip, film,
                       contact, impact (always); load (a load on an output inertia), seal (a
-                      piston), spline (splines), shaft (a compliant shaft)
+                      piston), spline (splines), shaft (a compliant shaft), convection (a
+                      [thermal] part: heat passed from the plates to the oil)
 
 Modes are (axial phase) x (rotation): axial phase "approach" (piston travelling freely, plates at
 rest; only with a piston and free travel) or "pressing"; rotation "slip_forward" (w_in > w_out),
@@ -28,9 +30,10 @@ from ..errors import ModelError
 from ..simulation.model import Event, HybridModel, Mode, time_derivative
 from .actuation import Actuation, read_table
 from .films import FilmLaw
+from .thermal import plate_thermal
 
 ENERGY_TERMS = ("E_source", "E_hydraulic", "E_load", "E_slip", "E_film", "E_contact", "E_seal", "E_spline", "E_shaft",
-                "E_impact")
+                "E_impact", "E_convection")
 ROTATIONS = ("slip_forward", "slip_reverse", "locked")
 
 
@@ -65,7 +68,8 @@ class EngagementModel:
             self.load_table = ca.interpolant("load_table", "linear", [data[:, 0]], data[:, 1])
             self.load_range = (float(data[0, 0]), float(data[-1, 0]))
         self.scene = scene
-        self.film = FilmLaw(scene, smooth=smooth)
+        self.thermal = plate_thermal(scene)
+        self.film = FilmLaw(scene, smooth=smooth, temperature=self.thermal.interface_temperature())
         self.actuation = Actuation(scene, command=pressure_command)
         self.n = scene.value("plates.n_interfaces")
         self.n_driving = 1 if scene.get("driveline.driving_films", "all") == "first" else self.n
@@ -125,16 +129,19 @@ class EngagementModel:
         if self.compliant:
             torque_scale = max(abs(s.value("driveline.input_torque")), 10.0)
             add("theta_shaft", torque_scale / self.shaft_stiffness, 0.0)
+        for spec in self.thermal.state_specs:
+            add(*spec)
         # Energy accumulators of the parts the scene has (a load, a piston seal, splines, a shaft)
         present = {"E_load": self.output_inertia and s.variant("load") not in ("", "none"),
-                   "E_seal": self.has_piston, "E_spline": s.has("spline"), "E_shaft": self.compliant}
+                   "E_seal": self.has_piston, "E_spline": s.has("spline"), "E_shaft": self.compliant,
+                   "E_convection": self.thermal.present}
         self.energy_terms = tuple(name for name in ENERGY_TERMS if present.get(name, True))
         for name in self.energy_terms:
             add(name, 1.0, 0.0)
         self.state_names = tuple(names)
         self.nominal = np.array(nominal, dtype=float)
         self.initial_state = np.array(initial, dtype=float)
-        self.x = ca.vertcat(*[ca.SX.sym(name) for name in names])
+        self.x = ca.vertcat(*[self.thermal.symbols.get(name, ca.SX.sym(name)) for name in names])
         self.index = {name: i for i, name in enumerate(names)}
 
     def state(self, name):
@@ -198,7 +205,7 @@ class EngagementModel:
     def seal_coefficient(self):
         """Viscous seal friction coefficient eta L pi D / psi [N s/m] (Bao Eq. 16)."""
         s = self.scene
-        return (self.film.eta * s.value("piston.seal_length") * math.pi * s.value("piston.seal_diameter")
+        return (s.value("oil.viscosity") * s.value("piston.seal_length") * math.pi * s.value("piston.seal_diameter")
                 / s.value("piston.seal_clearance"))
 
     def _spline_deductions(self, torques):
@@ -348,6 +355,8 @@ class EngagementModel:
         rate["E_spline"] = spline_power
         rate["E_shaft"] = shaft_power
         rate["E_impact"] = 0.0
+        heat_power = rate["E_slip"] + film_fluid_power          # released at the friction interfaces
+        rate.update(self.thermal.rates(heat_power))
         ode = ca.vertcat(*[rate[name] for name in self.state_names])
 
         # Outputs ------------------------------------------------------------------------------
@@ -373,6 +382,8 @@ class EngagementModel:
         out["output_acceleration_rad_s2"] = a_out
         out["output_jerk_rad_s3"] = jerk
         out["dissipated_power_W"] = rate["E_slip"] + film_fluid_power + seal_power + spline_power + shaft_power
+        out["interface_heat_power_W"] = heat_power
+        out.update(self.thermal.outputs())
         out["kinetic_energy_J"] = self._kinetic_energy()
         out["spring_energy_J"] = self.spring_energy(x0) if self.has_piston else 0.0
         if self.compliant:

@@ -74,6 +74,7 @@ def plot_engagement(run, out):
     files.append(_finish(fig, ax, run, out / "pressure.png", legend=False))
     if run.summary["torque_response_time_stable_s"] is not None:
         files.append(plot_torque_response(run, out / "torque_response.png"))
+    files.append(plot_heat(run, out / "heat.png"))
     return files
 
 
@@ -112,6 +113,32 @@ def plot_torque_response(run, path):
     return save_figure(fig, path)
 
 
+def plot_heat(run, path):
+    """Specific power of the friction area against time, and the plate temperatures if the scene
+    has a [thermal] part (left panel); returns the PNG path."""
+    res, model, summary = run.result, run.model, run.summary
+    t = res.t
+    fig, axes = new_figure(2 if model.thermal.present else 1)
+    ax = axes[-1]
+    ax.plot(t, res["interface_heat_power_W"] / summary["friction_area_mm2"], color="C3", label="specific power")
+    ax.set(xlabel="time [s]", ylabel="specific power [W/mm^2]",
+           title=f"specific energy {summary['specific_energy_J_mm2']:.3g} J/mm^2 "
+                 f"over {summary['friction_area_mm2']:.0f} mm^2 of friction area")
+    fig.suptitle(f"{summary['scene']}: heat of the engagement at the friction interfaces")
+    if model.thermal.present:
+        hot = axes[0]
+        hot.plot(t, res["interface_temperature_C"], "k", lw=1.5, label="interface (contact)")
+        hot.plot(t, res["T_separator"], "C0", label="separators (bulk)")
+        hot.plot(t, res["T_friction"], "C1", label="friction plates (bulk)")
+        hot.axhline(model.thermal.T_oil, color="C2", ls=":", label="oil")
+        hot.set(xlabel="time [s]", ylabel="temperature [degC]",
+                title=f"peak interface temperature {summary['peak_interface_temperature_C']:.1f} degC (lumped)")
+        if summary["engagement_time_s"] is not None:
+            hot.axvline(summary["engagement_time_s"], color="0.5", lw=0.8, ls="--", label="lock-up")
+        hot.legend(fontsize=8)
+    return _finish(fig, ax, run, path)
+
+
 def format_summary(summary):
     """A few lines for the terminal."""
     def num(key, unit, fmt="{:.4g}"):
@@ -127,6 +154,10 @@ def format_summary(summary):
         f"  torque response (Zhang)     {num('torque_response_time_stable_s', 's')} to 90 % of the stable "
         f"{num('stable_torque_Nm', 'N m')}; {num('torque_response_time_s', 's')} to 90 % of the peak",
         f"  dissipated energy           {num('dissipated_energy_J', 'J')}",
+        f"  specific energy             {num('specific_energy_J_mm2', 'J/mm^2', '{:.4g}')}",
+        f"  peak specific power         {num('peak_specific_power_W_mm2', 'W/mm^2', '{:.4g}')}",
+        *([f"  peak interface temperature  {num('peak_interface_temperature_C', 'degC', '{:.1f}')}"]
+          if "peak_interface_temperature_C" in summary else []),
         f"  energy balance error        {num('energy_balance_rel_error', '(relative)', '{:.2e}')}",
         f"  wall time                   {num('wall_time_s', 's', '{:.3f}')}",
     ]

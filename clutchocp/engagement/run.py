@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SolverError
+from ..errors import ModelError, SolverError
 from ..simulation import SimulationOptions, simulate
 from .model import ENERGY_TERMS, EngagementModel
 
@@ -26,13 +26,14 @@ class EngagementResult:
             if not name.startswith("E_"):
                 columns[name] = res[name]
         for name in res.names():
-            if name.endswith(("_m", "_Pa", "_rad_s", "_Nm", "_N", "_rad_s2", "_rad_s3", "_W", "_J")):
+            if name.endswith(("_m", "_Pa", "_rad_s", "_Nm", "_N", "_rad_s2", "_rad_s3", "_W", "_J", "_C")):
                 columns[name] = res[name]
+        columns["specific_power_W_mm2"] = res["interface_heat_power_W"] / self.summary["friction_area_mm2"]
         return columns
 
 
 def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=None, output_points=None,
-                        model=None, native=False, solver_options=None):
+                        model=None, native=False, solver_options=None, initial_state=None):
     """Simulate an engagement scene through impact, slip and lock-up.
 
     Parameters
@@ -60,6 +61,9 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     solver_options : dict, optional
         Further :class:`~clutchocp.simulation.SimulationOptions` fields, e.g.
         ``{"max_wall_time": 10.0}`` (a wall-time cap [s]) or ``{"event_value_tol": 1e-10}``.
+    initial_state : dict, optional
+        ``{state name: value}`` replacing the scene's initial values (e.g. the plate temperatures
+        ``T_friction``, ``T_separator`` [degC] of a repeated engagement).
 
     Returns
     -------
@@ -78,6 +82,11 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     grid = np.unique(np.concatenate([np.linspace(0.0, t_end, n_out),
                                      [b for b in model.actuation.breakpoints() if b < t_end]]))
     x0 = dict(zip(model.state_names, model.initial_state))
+    for name, value in (initial_state or {}).items():
+        if name not in x0:
+            raise ModelError(f"initial_state: '{name}' is not a state of scene '{scene.name}' "
+                             f"(states: {', '.join(model.state_names)})")
+        x0[name] = float(value)
     start = time.perf_counter()
     try:
         result = simulate(model.hybrid, x0, grid, mode=model.initial_mode(), options=options, method=method)
@@ -204,22 +213,27 @@ def energy_balance(model, result):
 
     work in (source + hydraulic - load + spring released) = kinetic energy change + contact
     (elastic) storage + dissipation (slip, film, seal, splines, shaft damping, impact); the spring
-    energy includes the twist of a compliant shaft.
+    energy includes the twist of a compliant shaft. With a [thermal] part the slip and film
+    dissipation is closed through the plates instead: it must equal the heat stored in them plus
+    the heat convected to the oil (so the balance checks the temperature states too).
     """
     E = {name: result.final(name) if name in model.energy_terms else 0.0 for name in ENERGY_TERMS}
     ke = result["kinetic_energy_J"]
     spring = result["spring_energy_J"]
     work_in = E["E_source"] + E["E_hydraulic"] - E["E_load"] + (spring[0] - spring[-1])
-    dissipated = E["E_slip"] + E["E_film"] + E["E_seal"] + E["E_spline"] + E["E_shaft"] + E["E_impact"]
+    interfaces = E["E_slip"] + E["E_film"]
+    dissipated = interfaces + E["E_seal"] + E["E_spline"] + E["E_shaft"] + E["E_impact"]
     stored = (ke[-1] - ke[0]) + E["E_contact"]
+    out = {"work_in_J": work_in, "kinetic_energy_change_J": ke[-1] - ke[0], "contact_storage_J": E["E_contact"],
+           "dissipated_J": dissipated}
+    closure = dissipated
+    if model.thermal.present:
+        out["heat_stored_J"] = float(result["stored_heat_J"][-1] - result["stored_heat_J"][0])
+        out["heat_to_oil_J"] = E["E_convection"]
+        closure = dissipated - interfaces + out["heat_stored_J"] + out["heat_to_oil_J"]
     scale = max(abs(work_in), abs(ke[-1] - ke[0]), abs(dissipated), 1e-12)
-    return {
-        "work_in_J": work_in,
-        "kinetic_energy_change_J": ke[-1] - ke[0],
-        "contact_storage_J": E["E_contact"],
-        "dissipated_J": dissipated,
-        "rel_error": abs(work_in - stored - dissipated) / scale,
-    }
+    out["rel_error"] = abs(work_in - stored - closure) / scale
+    return out
 
 
 def summarize(model, result, wall_time, options, method):
@@ -237,7 +251,7 @@ def summarize(model, result, wall_time, options, method):
     pressure_time, torque_time = response_times(model, result)
     stable_torque, stable_torque_time = stable_torque_response(model, result)
     jerk = result["output_jerk_rad_s3"]
-    return {
+    summary = {
         "scene": model.scene.name,
         "engagement_time_s": t_lock,
         "lockup_torque_jump_Nm": jump,
@@ -257,3 +271,29 @@ def summarize(model, result, wall_time, options, method):
         "solver": {"method": method, **{k: v for k, v in options.as_dict().items() if k != "idas_options"},
                    "statistics": result.stats},
     }
+    summary.update(thermal_summary(model, result))
+    return summary
+
+
+def thermal_summary(model, result):
+    """Heat numbers a clutch is sized by (JSON-ready; units in the key names).
+
+    The friction area is the nominal area of all interfaces, n_interfaces x pi (r2^2 - r1^2);
+    the interface heat is the slip and squeeze-film dissipation. The temperatures need a
+    [thermal] part.
+    """
+    area_mm2 = model.n * model.film.area * 1e6
+    heat = result["interface_heat_power_W"]
+    out = {"friction_area_mm2": area_mm2,
+           "interface_heat_J": float(result.final("E_slip") + result.final("E_film")),
+           "peak_specific_power_W_mm2": float(np.max(heat)) / area_mm2}
+    out["specific_energy_J_mm2"] = out["interface_heat_J"] / area_mm2
+    if model.thermal.present:
+        temperature = result["interface_temperature_C"]
+        k = int(np.argmax(temperature))
+        out.update({"peak_interface_temperature_C": float(temperature[k]),
+                    "peak_interface_temperature_time_s": float(result.t[k]),
+                    "final_interface_temperature_C": float(temperature[-1]),
+                    "final_friction_plate_temperature_C": float(result.final("T_friction")),
+                    "final_separator_temperature_C": float(result.final("T_separator"))})
+    return out

@@ -21,7 +21,8 @@ margin of 0.5 % makes the crossing transversal (measured: IDAS locks at the coll
 its event tolerance) and leaves a jump of -0.5 % of the locked torque.
 
 Constraints: t_f <= t_max, E <= E_max, films h >= h_min, 0 <= u <= actuation.max_pressure,
-|du/dt| <= rate limit, w_rel >= 0. The ``smooth`` term regularises the command: without it the
+|du/dt| <= rate limit, w_rel >= 0; optionally interface temperature <= max_temperature_C (a scene
+with [thermal]) and interface heat per friction area <= max_specific_power_W_mm2 (path constraints). The ``smooth`` term regularises the command: without it the
 command reaches the objective only through two integrations (valve lag, film) and IPOPT meets a
 nearly singular Hessian and a bang-bang command (measured on the default scene: weight 1e-4 gave a
 rate-limited bang-bang command; 0.1, the default, a smooth one for 8 % more jerk integral).
@@ -46,6 +47,7 @@ from ..errors import ModelError, SolverError
 from .bound import jerk_lower_bound, output_jerk_share
 from .collocation import DirectCollocation, StagedProblem
 from .derivatives import nlp_solver, structured_derivatives
+from .heat import heat_limits
 
 OBJECTIVE_TERMS = ("jerk", "energy", "time", "jump", "smooth")
 DEFAULT_WEIGHTS = {"jerk": 1.0, "energy": 0.0, "time": 0.0, "jump": 0.0, "smooth": 0.1}
@@ -150,11 +152,15 @@ class EngagementOCP:
         Replaces ``DirectCollocation(intervals, degree, scheme, control)``.
     baseline : clutchocp.engagement.run.EngagementResult, optional
         IDAS run of the scene's own profile (initial guess and scales; simulated if not given).
+    max_temperature_C : float, optional
+        Largest interface temperature [deg C] over the slip phase (needs a [thermal] part).
+    max_specific_power_W_mm2 : float, optional
+        Largest interface heat power per friction area [W/mm^2] over the slip phase.
     """
 
     def __init__(self, scene, *, intervals=100, degree=3, scheme="radau", control="linear", rate_limit=None,
                  h_min=None, jump="constraint", lock_margin=0.005, smooth=True, polish=True,
-                 transcription=None, baseline=None):
+                 transcription=None, baseline=None, max_temperature_C=None, max_specific_power_W_mm2=None):
         if jump not in JUMP_MODES:
             raise ModelError(f"jump '{jump}': allowed values are {', '.join(JUMP_MODES)}")
         if scene.kind != "engagement":
@@ -169,13 +175,15 @@ class EngagementOCP:
         if not (np.isfinite(lock_margin) and 0 <= lock_margin < 0.5):
             raise ModelError(f"lock_margin = {lock_margin!r}: must be a fraction in [0, 0.5)")
         self.options = {"intervals": intervals, "degree": degree, "scheme": scheme, "control": control,
-                        "rate_limit": rate_limit, "h_min": h_min, "jump": jump, "lock_margin": lock_margin}
+                        "rate_limit": rate_limit, "h_min": h_min, "jump": jump, "lock_margin": lock_margin,
+                        "max_temperature_C": max_temperature_C, "max_specific_power_W_mm2": max_specific_power_W_mm2}
         self.u = ca.SX.sym("pressure_command")
         self.lock_margin = float(lock_margin)
         self.smooth = bool(smooth)
         self.polish = bool(polish) and self.smooth
         self._exact = None
         self.model = EngagementModel(scene, smooth=smooth, pressure_command=self.u)
+        self.heat_limits = heat_limits(self.model, max_temperature_C, max_specific_power_W_mm2)
         start_mode = self.model.initial_mode()
         if start_mode != SLIP_MODE:
             raise ModelError(f"scene '{scene.name}' starts in mode '{start_mode}'; the optimisation covers a "
@@ -284,6 +292,8 @@ class EngagementOCP:
         }
         for i in range(model.n):
             physical[f"h_{i + 1}_m"] = mode.outputs[f"h_{i + 1}_m"]
+        physical.update({k: mode.outputs[k] for k in ("interface_heat_power_W", "interface_temperature_C")
+                         if k in mode.outputs})
         physical = {k: ca.SX(v) for k, v in physical.items()}
         if ca.depends_on(ca.vertcat(ode, *physical.values()), model.t):
             raise ModelError("the optimisation needs a time-invariant slip mode (a pressure command, not a profile)")
@@ -302,7 +312,8 @@ class EngagementOCP:
         w_scale = max(self.scene.value("driveline.input_speed"), self.scene.get("driveline.output_speed", 0.0), 1.0)
         slip = subs(w_rel) / w_scale
         weights = ca.SX.sym("weights", len(OBJECTIVE_TERMS))
-        self.dynamics_fn = ca.Function("dynamics", [xs, us, weights], [xdot, q, slip])
+        path = ca.vertcat(slip, *[subs(physical[name]) / limit for name, limit in self.heat_limits])
+        self.dynamics_fn = ca.Function("dynamics", [xs, us, weights], [xdot, q, path])
         # Objective and end conditions (w_rel = 0, jump = 0 unless penalised, energy <= E_max).
         Q = ca.SX.sym("Q", 2)
         T = ca.SX.sym("T")
@@ -331,8 +342,9 @@ class EngagementOCP:
         end_lb[-1], end_ub[-1] = -np.inf, np.inf                     # energy row: set per solve
         p0 = self.scene.value("actuation.initial_pressure") / self.scales.pressure_Pa
         return StagedProblem(self.dynamics_fn, np.append(self.x0 / self.nominal, 0.0), self.objective_fn,
-                             self.end_fn, x_lb, x_ub, np.array([0.0]), np.array([1.0]), np.array([0.0]),
-                             np.array([np.inf]), end_lb, end_ub,
+                             self.end_fn, x_lb, x_ub, np.array([0.0]), np.array([1.0]),
+                             np.array([0.0] + [-np.inf] * len(self.heat_limits)),
+                             np.array([np.inf] + [1.0] * len(self.heat_limits)), end_lb, end_ub,
                              u_rate=np.array([self.rate_limit * self.scales.time_s / self.scales.pressure_Pa])
                              if np.isfinite(self.rate_limit) else None,
                              u_initial=np.array([p0]))
@@ -487,6 +499,9 @@ class EngagementOCP:
             "peak_torque_Nm": float(np.max(np.abs(outputs_points["total_torque_Nm"]))),
             "objective": objective,
         }
+        if "interface_temperature_C" in outputs:
+            terms["peak_interface_temperature_C"] = float(max(outputs["interface_temperature_C"].max(),
+                                                              outputs_points["interface_temperature_C"].max()))
         states = {member: x_nodes[:, i] for i, name in enumerate(self._names) for member in self.state_groups[name]}
         return OptimalEngagement(T, starts, points, command_times, u_values, tr.control, states, outputs,
                                  outputs_points, terms, objective, stats, w, lam_x, lam_g, weights)

@@ -5,11 +5,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..engagement.report import plot_heat
 from ..errors import ClutchocpError, ModelError
 from ..output import new_figure, save_figure, write_csv, write_summary
 from ..scene import default_scene, load_scene
 from .baselines import baseline_label, simulate_baselines
 from .bound import jerk_lower_bound
+from .heat import heat_check
 from .problem import EngagementOCP
 from .replay import CommandModel
 from .verify import HOLD_DELAY, holding_pressure, run_numbers, verify
@@ -19,7 +21,7 @@ KEYS = ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral", "dissipat
 
 
 def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, intervals=100, degree=3,
-                 sweep_t_max=None, progress=True):
+                 sweep_t_max=None, progress=True, max_temperature_C=None, max_specific_power_W_mm2=None):
     """Optimal engagement pressure of a scene: solve, verify with IDAS, compare, write files.
 
     Parameters
@@ -40,6 +42,8 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         adds ``sweep`` to the summary and pareto.png).
     progress : bool
         Print progress lines (stages, sweep points) and the summary.
+    max_temperature_C, max_specific_power_W_mm2 : float, optional
+        Heat limits of the slip phase (see :mod:`clutchocp.optimal.heat`); adds ``heat`` to the summary.
 
     Returns
     -------
@@ -59,7 +63,8 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     out = Path(out_dir)
     start = time.perf_counter()
     say(f"optimize {scene.name}: building the collocation problem ({intervals} intervals, degree {degree})")
-    ocp = EngagementOCP(scene, intervals=intervals, degree=degree)
+    ocp = EngagementOCP(scene, intervals=intervals, degree=degree, max_temperature_C=max_temperature_C,
+                        max_specific_power_W_mm2=max_specific_power_W_mm2)
     build_time = time.perf_counter() - start
     opt = ocp.solve(t_max=t_max, weights=weights)
     say(f"  IPOPT {opt.stats['status']}: {opt.stats['iterations']} iterations, {opt.stats['wall_time_s']:.2f} s")
@@ -97,11 +102,13 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
                    "stages": [{k: s[k] for k in ("model", "status", "iterations", "wall_time_s", "warm_start")}
                               for s in opt.stats["stages"]]},
     }
+    summary["heat"] = heat_check(ocp, opt, replay)
     if sweep is not None:
         summary["sweep"] = sweep
     out.mkdir(parents=True, exist_ok=True)
     files = [_write_profile(out, ocp, opt), write_summary(out / "summary.json", summary)]
     files += plot_optimum(out, scene, opt, replay, ocp.baseline, baselines, summary)
+    files.append(plot_heat(replay, out / "heat.png"))
     if sweep is not None:
         files.append(plot_pareto(out, scene, sweep, w_rel0, rate0, ocp))
     summary["files"] = [str(f) for f in files]
@@ -264,6 +271,10 @@ def format_summary(summary):
                  f"(rel. diff {_num(ver['lock_time_rel_diff'])}), jump {_num(ver['torque_jump_Nm'])} N m "
                  f"-> {'passed' if ver['passed'] else 'FAILED'}")
     lines.append(f"  jerk integral / kinematic lower bound: {summary['jerk_lower_bound_ratio']:.3g}")
+    heat = summary.get("heat")
+    if heat is not None and "peak_interface_temperature_C" in heat["idas"]:
+        lines.append(f"  peak interface temperature: {heat['collocation']['peak_interface_temperature_C']:.2f} degC "
+                     f"(IDAS {heat['idas']['peak_interface_temperature_C']:.2f} degC)")
     return "\n".join(lines)
 
 

@@ -21,6 +21,7 @@ from ..errors import (
     UnknownKeyError,
     UnknownVariantError,
 )
+from ..physics.viscosity import walther_coefficients, walther_kinematic_viscosity
 from ..units import to_si
 from .schema import CHECKS, PARTS, REQUIRED_PARTS
 
@@ -211,6 +212,7 @@ def _cross_check(values, base_dir):
             _require(values, f"roughness.{key}", f"by contact model '{contact}'")
         if values["roughness"]["sigma"] <= 0:
             raise PhysicalRangeError(f"roughness.sigma = 0: must be > 0 with contact model '{contact}'")
+    _check_temperatures(values)
     friction = values.get("friction", {})
     if friction.get("model") == "table":
         p, mu = friction["pressure"], friction["mu"]
@@ -245,6 +247,39 @@ def _cross_check(values, base_dir):
     piston = values.get("piston")
     if piston is not None and piston["model"] == "spring_applied" and piston["spring_stiffness"] <= 0:
         raise PhysicalRangeError("piston.spring_stiffness: must be > 0 for a spring-applied piston")
+
+
+def _check_temperatures(values):
+    """The [thermal] part, the Walther oil and Chen's friction law: each temperature given once.
+
+    A Walther oil gets its derived ``oil.viscosity`` [Pa s] at the oil temperature, for the parts
+    that read a constant viscosity (piston seal, HVD and static analyses).
+    """
+    thermal, oil, friction = values.get("thermal"), values.get("oil", {}), values.get("friction", {})
+    if thermal is not None:
+        if values["scene"]["kind"] != "engagement":
+            raise SceneError("[thermal]: plate temperatures are modelled for engagement scenes only")
+        thermal.setdefault("initial_temperature_C", thermal["oil_temperature_C"])
+    if friction.get("model") == "chen2021":
+        _fixed_temperature("friction", friction, thermal is not None, "Chen's law reads the interface temperature")
+    if oil.get("model") != "walther":
+        return
+    _fixed_temperature("oil", oil, thermal is not None, "the oil temperature is thermal.oil_temperature_C")
+    try:
+        A, B = walther_coefficients(40.0, oil["kinematic_viscosity_40C"], 100.0, oil["kinematic_viscosity_100C"])
+    except PhysicalRangeError as exc:
+        raise PhysicalRangeError(f"oil.kinematic_viscosity_40C, oil.kinematic_viscosity_100C: {exc}") from None
+    theta = thermal["oil_temperature_C"] if thermal is not None else oil["temperature_C"]
+    oil["viscosity"] = oil["density"] * float(walther_kinematic_viscosity(theta, A, B))
+
+
+def _fixed_temperature(part, table, has_thermal, with_thermal):
+    """``<part>.temperature_C``, a law's fixed temperature: required without [thermal], refused with it."""
+    if has_thermal and "temperature_C" in table:
+        raise SceneError(f"{part}.temperature_C: not used with a [thermal] part ({with_thermal}); remove it")
+    if not has_thermal and "temperature_C" not in table:
+        raise MissingParameterError(f"{part}.temperature_C: missing, required by {part}.model = '{table['model']}' "
+                                    "without a [thermal] part")
 
 
 class Scene:

@@ -18,6 +18,7 @@ CHECKS = {
     "area_factor": (lambda v: 1 <= v <= 2, "in [1, 2] (Bao Eq. 18)"),
     "angle": (lambda v: 0 <= v < 1.5707963267948966, "in [0, 90) deg"),
     "friction": (lambda v: 0 < v < 2, "in (0, 2)"),
+    "celsius": (lambda v: v > -273.15, "above absolute zero (> -273.15 degC)"),
     "any": (lambda v: True, "any value"),
 }
 
@@ -114,11 +115,21 @@ PARTS = {
         },
     ),
     "oil": Part(
-        "lubricant",
+        "lubricant: a constant viscosity, or Walther's law (ASTM D341) through two datasheet points",
         fields={
-            "viscosity": Q("Pa s", doc="dynamic viscosity [Pa s]"),
-            "density": QOpt("kg/m^3", 870.0, "positive", "density [kg/m^3]"),
+            "density": QOpt("kg/m^3", 870.0, "positive", "density [kg/m^3] (taken constant)"),
         },
+        variants={
+            "constant": {"viscosity": Q("Pa s", doc="dynamic viscosity [Pa s]")},
+            "walther": {
+                "kinematic_viscosity_40C": Q("m^2/s", doc="kinematic viscosity at 40 degC [m^2/s] (datasheet)"),
+                "kinematic_viscosity_100C": Q("m^2/s", doc="kinematic viscosity at 100 degC [m^2/s] (datasheet)"),
+                "temperature_C": QOpt("1", None, "celsius",
+                                      "oil temperature [deg C] of a scene without [thermal] (with it: "
+                                      "thermal.oil_temperature_C)"),
+            },
+        },
+        default_variant="constant",
     ),
     "film": Part(
         "squeeze-film options of the averaged Reynolds equation",
@@ -185,8 +196,9 @@ PARTS = {
                 "mu_kinetic": Q("1", "friction", "COF at high slip"),
                 "v_stribeck": Q("m/s", doc="Stribeck velocity [m/s]"),
             },
-            "chen2021": {"temperature_C": Field(kind="quantity", dim="1", check="positive",
-                                                doc="surface temperature [deg C] (Chen Eq. 5)")},
+            "chen2021": {"temperature_C": Field(kind="quantity", dim="1", check="positive", required=False,
+                                                doc="surface temperature [deg C] (Chen Eq. 5); with a "
+                                                    "[thermal] part the law reads the interface temperature")},
             "cui2019": {},
             "table": {
                 "pressure": Field(kind="quantity_list", dim="Pa", check="nonnegative",
@@ -313,6 +325,25 @@ PARTS = {
             "table": {"file": Field(kind="str", doc="CSV file (speed rad/s, torque N m)")},
         },
         default_variant="none",
+    ),
+    "thermal": Part(
+        "lumped plate temperatures (optional): the heat of the slip and squeeze films, stored in the "
+        "friction plates and separators and convected to the oil",
+        fields={
+            "oil_temperature_C": Q("1", "celsius", "cooling-oil temperature [deg C]"),
+            "initial_temperature_C": QOpt("1", None, "celsius",
+                                          "plate temperature at t = 0 [deg C] (default: the oil temperature)"),
+            "separator_heat_capacity": Q("J/K", doc="heat capacity of the separator steel heated by the pack's "
+                                                    "interfaces, whole pack [J/K]"),
+            "friction_plate_heat_capacity": Q("J/K", doc="heat capacity of the friction plates (core and "
+                                                         "lining), whole pack [J/K]"),
+            "heat_partition": Q("1", "unit_interval",
+                                "share of the interface heat that enters the separators [-]: e_s / (e_s + e_f) "
+                                "with the thermal effusivities e = sqrt(k rho c) of separator and lining"),
+            "convection_coefficient": Q("W/m^2/K", "nonnegative",
+                                        "heat transfer coefficient to the oil [W/(m^2 K)], over one face "
+                                        "area per interface for each of the two plate groups"),
+        },
     ),
     "simulation": Part(
         "integration settings",

@@ -31,7 +31,7 @@ from pathlib import Path
 from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..engagement.stiffness import stiffness_profile, write_stiffness
-from ..output import write_csv, write_summary
+from ..output import shown, write_csv, write_summary, writes_folder
 from ..scene.loader import list_scenes
 from ..simulation.native import compiler
 from . import floor, optimization, scaling, workprecision
@@ -58,6 +58,7 @@ def _steps(settings, n_scenes, opt_steps):
     return n_scenes * per_scene + opt_steps
 
 
+@writes_folder
 def run_bench(out_dir, quick=False, progress=True, scenes=None):
     """Run the benchmark and write its files.
 
@@ -125,8 +126,8 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
                "single_run_s": single, "targets": _targets(per_scene),
                "engagement_targets": _engagement_targets(per_scene, single), "wall_time_s": time.perf_counter() - start}
     files.append(write_summary(out / "summary.json", json_ready(summary)))
-    summary["files"] = [str(f) for f in files]
-    bar.note(f"done in {summary['wall_time_s']:.0f} s; wrote {len(files)} files to {out}")
+    summary["files"] = [shown(f) for f in files]
+    bar.note(f"done in {summary['wall_time_s']:.0f} s; wrote {len(files)} files to {shown(out)}")
     return summary
 
 

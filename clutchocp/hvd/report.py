@@ -16,7 +16,7 @@ import control
 import numpy as np
 from matplotlib.ticker import FormatStrFormatter, NullFormatter
 
-from ..output import new_figure, save_figure, write_csv, write_summary
+from ..output import new_figure, save_figure, shown, write_csv, write_summary, writes_folder
 from ..scene import Scene, load_scene
 from .closed_loop import make_scenario, simulate_closed_loop
 from .design import design, frequency_response
@@ -27,6 +27,7 @@ from .steady import static_map
 DEFAULT_CONTROLLER = "lqi"
 
 
+@writes_folder
 def run_control(scene, controller=None, out_dir="out/control", verbose=True):
     """Design and check a speed controller for an HVD scene; write the report files.
 
@@ -63,7 +64,7 @@ def run_control(scene, controller=None, out_dir="out/control", verbose=True):
     files += _figures(out, model, spec, sched, run, data)
     if verbose:
         print(format_summary(summary))
-        print(f"wrote {len(files)} files to {out}: {', '.join(f.name for f in files)}")
+        print(f"wrote {len(files)} files to {shown(out)}: {', '.join(f.name for f in files)}")
     return summary
 
 

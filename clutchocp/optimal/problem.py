@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from .. import interrupt
 from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
@@ -434,6 +435,7 @@ class EngagementOCP:
         start = time.perf_counter()
         sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p)
         wall = time.perf_counter() - start
+        interrupt.check(f"IPOPT (scene '{self.scene.name}', t_max = {t_max:.4g} s)")
         st = solver.stats()
         stats = {"status": st["return_status"], "success": bool(st["success"]), "iterations": int(st["iter_count"]),
                  "wall_time_s": wall, "warm_start": bool(warm), "n_variables": int(w0.size),

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ClutchocpError, ModelError
-from ..output import new_figure, save_figure, write_csv, write_summary
+from ..output import new_figure, save_figure, shown, write_csv, write_summary, writes_folder
 from ..scene import default_scene, load_scene
 from .baselines import baseline_label, simulate_baselines
 from .bound import jerk_lower_bound
@@ -18,6 +18,7 @@ KEYS = ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral", "dissipat
         "peak_torque_Nm")
 
 
+@writes_folder
 def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, intervals=100, degree=3,
                  sweep_t_max=None, progress=True):
     """Optimal engagement pressure of a scene: solve, verify with IDAS, compare, write files.
@@ -104,7 +105,7 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     files += plot_optimum(out, scene, opt, replay, ocp.baseline, baselines, summary)
     if sweep is not None:
         files.append(plot_pareto(out, scene, sweep, w_rel0, rate0, ocp))
-    summary["files"] = [str(f) for f in files]
+    summary["files"] = [shown(f) for f in files]
     say(format_summary(summary))
     return summary
 

@@ -92,13 +92,16 @@ def _check_value(name, value, spec, unit_hint):
         raise PhysicalRangeError(f"{name} = {value:g}{unit_hint}: must be {phrase}")
 
 
-def _parse_field(name, raw, spec):
-    """Convert one raw TOML value to its SI value, or raise a one-line SceneError."""
+def _parse_field(name, raw, spec, density=None):
+    """Convert one raw TOML value to its SI value, or raise a one-line SceneError.
+
+    ``density`` [kg/m^3] converts a kinematic viscosity (cSt) given for a dynamic one.
+    """
     unit_hint = "" if spec.dim == "1" else f" (SI, {spec.dim})"
     if spec.kind == "quantity":
         if isinstance(raw, (list, dict)):
             raise ParameterTypeError(f"{name}: expected one number or quantity in {spec.dim}, got a {type(raw).__name__}")
-        value = to_si(raw, spec.dim, name)
+        value = to_si(raw, spec.dim, name, density=density)
         _check_value(name, value, spec, unit_hint)
         return value
     if spec.kind == "quantity_list":
@@ -162,10 +165,11 @@ def _validate_part(part_name, table):
                 f"{part_name}.{key}: unknown key in [{where}]{_suggest(key, options)} "
                 f"(allowed: {', '.join(options)})"
             )
-    for key, spec in allowed.items():
+    # the density first: a viscosity given in cSt is converted with it (mu = rho nu)
+    for key, spec in sorted(allowed.items(), key=lambda item: item[0] != "density"):
         name = f"{part_name}.{key}"
         if key in table:
-            values[key] = _parse_field(name, table[key], spec)
+            values[key] = _parse_field(name, table[key], spec, density=values.get("density"))
         elif spec.required:
             raise MissingParameterError(f"{name}: missing required parameter ({spec.doc})")
         elif spec.default is not None:

@@ -8,6 +8,10 @@ left out: the model then compiles without them (no states, no equations, no cost
 
 from dataclasses import dataclass, field as dc_field
 
+MAX_PRESSURE = 1e8           # Pa
+MAX_OUTPUT_POINTS = 200_000
+MAX_INTERFACES = 64
+
 # Value checks: name -> (predicate on the SI value, phrase for the error message).
 CHECKS = {
     "positive": (lambda v: v > 0, "> 0"),
@@ -19,6 +23,18 @@ CHECKS = {
     "angle": (lambda v: 0 <= v < 1.5707963267948966, "in [0, 90) deg"),
     "friction": (lambda v: 0 < v < 2, "in (0, 2)"),
     "any": (lambda v: True, "any value"),
+    # Limits that protect the machine and the meaning of a result (see RESOURCE_LIMITS):
+    "pressure": (lambda v: 0 <= v <= MAX_PRESSURE, "in [0, 1e8] Pa (100 MPa is above any clutch or valve pressure)"),
+    "positive_pressure": (lambda v: 0 < v <= MAX_PRESSURE,
+                          "in (0, 1e8] Pa (100 MPa is above any clutch or valve pressure)"),
+    "output_points": (lambda v: 2 <= v <= MAX_OUTPUT_POINTS,
+                      f"from 2 to {MAX_OUTPUT_POINTS} (each point keeps every state and output: "
+                      "200 000 points are about 100 MB of results)"),
+    "interfaces": (lambda v: 1 <= v <= MAX_INTERFACES,
+                   f"from 1 to {MAX_INTERFACES} (one film state each; no wet clutch has more, and the run "
+                   "time grows faster than the count: 64 films took 8 s, 5000 ran for minutes)"),
+    "tolerance": (lambda v: 1e-14 <= v <= 1e-2, "from 1e-14 to 1e-2 (looser tolerances give errors of percents)"),
+    "duration": (lambda v: 1e-3 <= v <= 1e4, "from 1e-3 s to 1e4 s (an engagement lasts milliseconds to seconds)"),
 }
 
 
@@ -104,7 +120,7 @@ PARTS = {
         fields={
             "r_inner": Q("m", doc="inner radius of the friction surface [m]"),
             "r_outer": Q("m", doc="outer radius of the friction surface [m]"),
-            "n_interfaces": Field(kind="int", check="positive",
+            "n_interfaces": Field(kind="int", check="interfaces",
                                   doc="number of lubricated friction interfaces (films)"),
             "land_fraction": QOpt("1", 1.0, "fraction", "non-grooved share of the area (Cui psi)"),
             "lining_thickness": QOpt("m", 0.0, doc="friction-lining thickness d [m] (Zhang)"),
@@ -127,7 +143,7 @@ PARTS = {
                                  default="patir_cheng", doc="pressure flow factor phi_r"),
             "centrifugal": Field(kind="bool", required=False, default=False,
                                  doc="include the centrifugal term (Bao Eq. 11)"),
-            "inlet_pressure": QOpt("Pa", 0.0, doc="oil pressure at the inner radius [Pa]"),
+            "inlet_pressure": QOpt("Pa", 0.0, "pressure", doc="oil pressure at the inner radius [Pa]"),
         },
     ),
     "roughness": Part(
@@ -178,7 +194,7 @@ PARTS = {
                 "mu_kinetic": Q("1", "friction", "COF at high slip"),
                 "v_stribeck": Q("m/s", doc="Stribeck velocity [m/s]"),
             },
-            "chen2021": {"temperature_C": Field(kind="quantity", dim="1", check="positive",
+            "chen2021": {"temperature_C": Field(kind="quantity", dim="degC", check="positive",
                                                 doc="surface temperature [deg C] (Chen Eq. 5)")},
             "cui2019": {},
             "table": {
@@ -221,8 +237,8 @@ PARTS = {
         fields={
             "speed_input": QOpt("rad/s", 0.0, doc="input (friction plate) speed [rad/s]"),
             "speed_output": QOpt("rad/s", 0.0, doc="output (separator) speed [rad/s]"),
-            "temperature_C": QOpt("1", None, "positive", "oil / surface temperature [deg C]"),
-            "pressures": Field(kind="quantity_list", dim="Pa", check="nonnegative", required=False,
+            "temperature_C": QOpt("degC", None, "positive", "oil / surface temperature [deg C]"),
+            "pressures": Field(kind="quantity_list", dim="Pa", check="pressure", required=False,
                                doc="applied pressures [Pa]"),
         },
     ),
@@ -258,12 +274,12 @@ PARTS = {
     "actuation": Part(
         "engagement pressure",
         fields={
-            "pressure": Q("Pa", "nonnegative", "set pressure P_o [Pa]"),
-            "initial_pressure": QOpt("Pa", 0.0, doc="pressure at t = 0 [Pa]"),
+            "pressure": Q("Pa", "pressure", "set pressure P_o [Pa]"),
+            "initial_pressure": QOpt("Pa", 0.0, "pressure", doc="pressure at t = 0 [Pa]"),
             "t_start": QOpt("s", 0.0, doc="time the command starts [s]"),
             "area": QOpt("m^2", None, "positive",
                          "area the pressure acts on when there is no piston [m^2] (default: plate area)"),
-            "max_pressure": QOpt("Pa", None, "positive", "upper pressure limit [Pa]"),
+            "max_pressure": QOpt("Pa", None, "positive_pressure", "upper pressure limit [Pa]"),
         },
         variants={
             "step": {},
@@ -307,10 +323,10 @@ PARTS = {
     "simulation": Part(
         "integration settings",
         fields={
-            "t_end": Q("s", doc="end time [s]"),
-            "rtol": QOpt("1", 1e-8, "positive", "relative tolerance"),
-            "atol": QOpt("1", 1e-10, "positive", "absolute tolerance (scaled states)"),
-            "output_points": Field(kind="int", check="positive", required=False, default=2001,
+            "t_end": Q("s", "duration", doc="end time [s]"),
+            "rtol": QOpt("1", 1e-8, "tolerance", "relative tolerance"),
+            "atol": QOpt("1", 1e-10, "tolerance", "absolute tolerance (scaled states)"),
+            "output_points": Field(kind="int", check="output_points", required=False, default=2001,
                                    doc="number of output times"),
         },
     ),
@@ -327,8 +343,8 @@ PARTS = {
                                        "free-surface radius r0 of the rotating control oil [m] (Liao Eq. 15); "
                                        "absent: no centrifugal cylinder force"),
             "valve_time_constant": Q("s", doc="time constant of the pressure valve [s] (a state)"),
-            "pressure_min": QOpt("Pa", 0.0, doc="lowest control pressure the valve gives [Pa]"),
-            "pressure_max": Q("Pa", doc="highest control pressure the valve gives [Pa]"),
+            "pressure_min": QOpt("Pa", 0.0, "pressure", doc="lowest control pressure the valve gives [Pa]"),
+            "pressure_max": Q("Pa", "positive_pressure", doc="highest control pressure the valve gives [Pa]"),
             "spline_friction": QOpt("1", None, "friction",
                                     "friction coefficient f of the plates in their splines (Liao Eq. 10); "
                                     "needed with [hvc]"),

@@ -115,7 +115,7 @@ def _take_lock(lock, text, field):
                 pid = int(lock.read_text().strip() or 0)
             except (OSError, ValueError):
                 pid = 0
-            if pid and pid != os.getpid() and _pid_alive(pid):
+            if pid and _pid_alive(pid):
                 raise OutputFolderError(f"{field} {text}: another clutchocp run (process {pid}) is writing this "
                                         "folder; wait for it to finish or give another folder") from None
             lock.unlink(missing_ok=True)          # left behind by a run that was killed

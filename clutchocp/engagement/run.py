@@ -7,6 +7,7 @@ import numpy as np
 
 from ..errors import SolverError
 from ..simulation import SimulationOptions, simulate
+from ..simulation.locate import crossing_time, peak
 from .model import ENERGY_TERMS, EngagementModel
 
 
@@ -124,15 +125,14 @@ def explain_failure(model, err):
     return new
 
 
-def _first_crossing(t, y, level):
-    """First time y reaches ``level`` (linear interpolation), or None."""
-    above = np.nonzero(y >= level)[0]
-    if above.size == 0:
-        return None
-    k = above[0]
-    if k == 0:
-        return float(t[0])
-    return float(t[k - 1] + (level - y[k - 1]) * (t[k] - t[k - 1]) / (y[k] - y[k - 1]))
+def pieces(result):
+    """Label of each sample: the index of its segment (one mode between two events)."""
+    return np.concatenate([np.full(seg.t.size, i) for i, seg in enumerate(result.segments)])
+
+
+def _first_crossing(t, y, level, piece=None):
+    """First time y reaches ``level``, located on the local cubic of the samples (or None)."""
+    return crossing_time(t, y, level, piece=piece)
 
 
 def response_times(model, result):
@@ -141,17 +141,18 @@ def response_times(model, result):
     Pressure response: from 10 % to 90 % of the set pressure. Torque response: from 50 % of
     the set pressure to 90 % of the transmitted torque, taken as the largest slipping torque.
     """
-    t, p = result.t, result["pressure_Pa"]
+    t, p, piece = result.t, result["pressure_Pa"], pieces(result)
     p_set = model.scene.value("actuation.pressure")
     p0 = model.scene.value("actuation.initial_pressure")
-    rise = lambda frac: _first_crossing(t, (p - p0) / (p_set - p0), frac) if p_set != p0 else None  # noqa: E731
+    rise = lambda frac: _first_crossing(t, (p - p0) / (p_set - p0), frac, piece) if p_set != p0 else None  # noqa: E731
     t10, t50, t90 = rise(0.1), rise(0.5), rise(0.9)
     pressure_time = t90 - t10 if t10 is not None and t90 is not None else None
     slipping = np.concatenate([np.full(seg.t.size, not str(seg.mode).endswith("locked")) for seg in result.segments])
     torque = np.abs(result["total_torque_Nm"])
     torque_time = None
     if t50 is not None and slipping.any():
-        t90_torque = _first_crossing(t[slipping], torque[slipping], 0.9 * torque[slipping].max())
+        t90_torque = _first_crossing(t[slipping], torque[slipping],
+                                     0.9 * peak(t[slipping], torque[slipping], piece[slipping])[0], piece[slipping])
         if t90_torque is not None:
             torque_time = t90_torque - t50
     return pressure_time, torque_time
@@ -198,7 +199,7 @@ def summarize(model, result, wall_time, options, method):
         "scene": model.scene.name,
         "engagement_time_s": t_lock,
         "lockup_torque_jump_Nm": jump,
-        "peak_torque_Nm": float(np.max(np.abs(result["total_torque_Nm"]))),
+        "peak_torque_Nm": peak(result.t, np.abs(result["total_torque_Nm"]), pieces(result))[0],
         "peak_jerk_rad_s3": float(np.max(np.abs(jerk[np.isfinite(jerk)]))),
         "dissipated_energy_J": energy["dissipated_J"],
         "energy_balance_rel_error": energy["rel_error"],

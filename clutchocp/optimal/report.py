@@ -82,7 +82,10 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         "verification": {k: check[k] for k in ("lock_time_rel_diff", "lock_time_resolution_s", "torque_jump_Nm",
                                               "torque_jump_rel", "passed", "holding_pressure_Pa", "collocation",
                                               "idas")},
-        "jerk_lower_bound": bound,
+        # the bound on the same basis as optimal.jerk_integral (output jerk; the slip jerk's bound
+        # times the output's share squared), and the slip-jerk bound the ratio is taken against
+        "jerk_lower_bound": bound * ocp.output_jerk_share**2,
+        "slip_jerk_lower_bound": bound,
         "jerk_lower_bound_ratio": opt.terms["slip_jerk_integral"] / bound,
         "initial_slip_rad_s": w_rel0,
         "initial_slip_rate_rad_s2": rate0,

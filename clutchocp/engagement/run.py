@@ -20,14 +20,22 @@ class EngagementResult:
     summary: dict
 
     def series(self):
-        """Time series on the output grid and at both sides of each event: {column: array}."""
+        """Time series on the output grid and at both sides of each event: {column: array}.
+
+        Besides the states and outputs, the energy accumulators E_x of the run are columns
+        ``x_energy_J`` (work or energy since t = 0 [J]): with ``kinetic_energy_J`` and
+        ``spring_energy_J`` they close the energy balance from the table alone (a transient of
+        microseconds, bao2020's plate impact, is not resolved by any output grid).
+        """
         res = self.result
         columns = {"time_s": res.t, "mode": res.mode}
         for name in self.model.state_names:
             if not name.startswith("E_"):
                 columns[name] = res[name]
+        for name in self.model.energy_terms:
+            columns[f"{name[2:]}_energy_J"] = res[name]
         for name in res.names():
-            if name.endswith(("_m", "_Pa", "_rad_s", "_Nm", "_N", "_rad_s2", "_rad_s3", "_W", "_J")):
+            if name.endswith(("_m", "_m_s", "_Pa", "_rad_s", "_Nm", "_N", "_rad_s2", "_rad_s3", "_W", "_J")):
                 columns[name] = res[name]
         return columns
 

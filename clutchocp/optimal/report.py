@@ -206,30 +206,62 @@ def plot_optimum(out, scene, opt, replay, baseline, baselines, summary):
     ax.legend(fontsize=7)
     files.append(save_figure(fig, out / "speeds.png"))
 
-    fig, (ax1, ax2) = new_figure(2, width=4.8)
-    labels = ["optimal"] + list(baselines)
-    jumps = [abs(summary["verification"]["torque_jump_Nm"] or 0.0)] + \
-        [abs(n["lockup_torque_jump_Nm"] or 0.0) for _, n in baselines.values()]
-    jerks = [summary["optimal"]["jerk_integral"]] + [n["jerk_integral"] or 0.0 for _, n in baselines.values()]
-    colors = ["C0"] + ["C3"] * len(baselines)
-    ax1.bar(labels, jumps, color=colors)
-    ax1.set(ylabel="|lock-up torque jump| [N m]", title="torque jump at lock-up")
-    ax2.bar(labels, jerks, color=colors)
-    ax2.set(ylabel="int jerk^2 dt [rad^2/s^5]", title="jerk integral (slip phase)")
-    for ax in (ax1, ax2):
-        ax.tick_params(axis="x", labelrotation=60, labelsize=7)
-    files.append(save_figure(fig, out / "baselines.png"))
+    w_rel0, rate0 = summary["initial_slip_rad_s"], summary["initial_slip_rate_rad_s2"]
+    share = summary["jerk_lower_bound"] / summary["slip_jerk_lower_bound"] if summary["slip_jerk_lower_bound"] else 0.0
+    files.append(plot_baselines(out, name, summary, baselines, lambda T: jerk_lower_bound(w_rel0, rate0, T) * share))
     return files
 
 
+def plot_baselines(out, name, summary, baselines, bound_at):
+    """baselines.png: lock-up jumps, and jerk integrals against engagement time with the kinematic bound.
+
+    ``bound_at(T)``: the kinematic lower bound of the output jerk integral for engagement time T [s].
+
+    The jerk integral falls steeply with the engagement time (the bound ~ 1/T^3), so a slower
+    profile can have less jerk than the optimum for a shorter time limit; the right panel therefore
+    draws each profile at its own engagement time, beside the lower bound for every time.
+    """
+    fig, (ax1, ax2) = new_figure(2, width=5.2)
+    labels = ["optimal"] + list(baselines)
+    numbers = [dict(summary["optimal"], lockup_torque_jump_Nm=summary["verification"]["torque_jump_Nm"])] + \
+        [n for _, n in baselines.values()]
+    times = [n["engagement_time_s"] for n in numbers]
+    jumps = [abs(n["lockup_torque_jump_Nm"] or 0.0) for n in numbers]
+    colors = ["C0"] + ["C3"] * len(baselines)
+    bars = ax1.bar(labels, jumps, color=colors)
+    for bar, t_lock in zip(bars, times):
+        ax1.annotate("never" if t_lock is None else f"{t_lock:.3g} s", (bar.get_x() + bar.get_width() / 2,
+                     bar.get_height()), ha="center", va="bottom", fontsize=6)
+    ax1.set(ylabel="|lock-up torque jump| [N m]", title="torque jump at lock-up (label: lock-up time)")
+    ax1.tick_params(axis="x", labelrotation=60, labelsize=7)
+    ok = [(t, n["jerk_integral"], lab) for t, n, lab in zip(times, numbers, labels)
+          if t is not None and n["jerk_integral"] is not None]
+    for t_lock, jerk, label in ok:
+        is_opt = label == "optimal"
+        ax2.plot(t_lock, jerk, "*" if is_opt else "o", color="C0" if is_opt else "C3", ms=12 if is_opt else 6)
+        ax2.annotate(label, (t_lock, jerk), textcoords="offset points", xytext=(4, 3), fontsize=7)
+    if ok:
+        grid = np.linspace(0.8 * min(t for t, _, _ in ok), 1.2 * max(t for t, _, _ in ok), 200)
+        bound = [bound_at(T) for T in grid]
+        if max(bound) > 0:
+            ax2.plot(grid, bound, "k--", lw=0.8, label="kinematic lower bound (same engagement time)")
+        ax2.plot([], [], "*", color="C0", ms=10, label="optimal")
+        ax2.plot([], [], "o", color="C3", label="baseline profiles")
+        ax2.legend(fontsize=7)
+    ax2.set(xlabel="engagement (lock-up) time [s]", ylabel="int jerk^2 dt, slip phase [rad^2/s^5]", yscale="log",
+            title=f"{name}: jerk against engagement time")
+    ax2.grid(alpha=0.3, which="both")
+    return save_figure(fig, out / "baselines.png")
+
+
 def _locks(ax, runs):
-    """Mark the lock-up times and show the time axis up to 1.5 x the later one."""
+    """Mark the lock-up times (in the legend) and show the time axis up to 1.5 x the later one."""
     t_end = max([run.summary["engagement_time_s"] or run.result.t[-1] for _, run, _ in runs])
     ax.set_xlim(0.0, 1.5 * t_end)
-    for _, run, color in runs:
+    for label, run, color in runs:
         t_lock = run.summary["engagement_time_s"]
         if t_lock is not None:
-            ax.axvline(t_lock, color=color, lw=0.8, ls=":")
+            ax.axvline(t_lock, color=color, lw=0.8, ls=":", label=f"lock-up, {label.split(' (')[0]}: {t_lock:.4g} s")
 
 
 def plot_pareto(out, scene, sweep, w_rel0, rate0, ocp):

@@ -3,6 +3,8 @@
 from pathlib import Path
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
 from ..output import new_figure, save_figure, write_csv, write_summary
 
@@ -112,6 +114,38 @@ def plot_engagement(run, out):
     ax0.legend(fontsize=8)
     files.append(_finish(fig, ax, run, out / "pressure.png"))
     return files
+
+
+def overview_figure(run):
+    """One figure of a run (``EngagementResult.plot``): films, speeds, clutch torque and pressure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    res, model, name = run.result, run.model, run.summary["scene"]
+    t = res.t
+    fig = Figure(figsize=(11.0, 7.0), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = [fig.add_subplot(2, 2, k + 1) for k in range(4)]
+    for i in range(model.n):
+        axes[0].plot(t, res[f"h_{i + 1}_m"] * 1e6, label=f"film {i + 1}")
+    axes[0].set(ylabel="film thickness [um]", yscale="log", title=f"{name}: oil films")
+    axes[1].plot(t, res["w_in_rad_s"], label="input")
+    axes[1].plot(t, res["w_out_rad_s"], label="output")
+    axes[1].set(ylabel="speed [rad/s]", title="speeds")
+    axes[2].plot(t, res["viscous_torque_Nm"], label="viscous")
+    axes[2].plot(t, res["contact_torque_Nm"], label="asperity contact")
+    axes[2].plot(t, res["total_torque_Nm"], "k", lw=1.5, label="total")
+    axes[2].set(ylabel="clutch torque [N m]", title="torque")
+    axes[3].plot(t, res["pressure_Pa"] / 1e6, label="pressure")
+    axes[3].set(ylabel="pressure [MPa]", title="actuation pressure")
+    for ax in axes:
+        ax.set_xlabel("time [s]")
+        ax.grid(alpha=0.3)
+        _mark_lockup(ax, run)
+        ax.legend(fontsize=7)
+    return fig
 
 
 def format_summary(summary):

@@ -2,22 +2,68 @@
 
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import SolverError
+from ..simulation.result import Table
 from ..simulation import SimulationOptions, simulate
 from ..simulation.locate import crossing_time, peak
+from ..scene import load_scene
+from ..scene.loader import check_value
 from .model import ENERGY_TERMS, EngagementModel
 
 
-@dataclass
+def check_run_settings(**settings):
+    """Check rtol, atol, t_end and output_points given to a run as the scene's [simulation] values are.
+
+    None means "the scene's value". Raises a PhysicalRangeError naming the argument.
+    """
+    from ..scene.schema import PARTS
+    fields = PARTS["simulation"].fields
+    for name, value in settings.items():
+        if value is not None:
+            check_value(name, value, fields[name])
+
+
+@dataclass(repr=False)
 class EngagementResult:
-    """An engagement run: the model, the raw hybrid result and its summary (``summary`` is JSON-ready)."""
+    """An engagement run: the model, the raw hybrid result and its summary (``summary`` is JSON-ready).
+
+    ``table()`` gives the time series with units, ``plot()`` an overview figure.
+    """
 
     model: EngagementModel
     result: object
     summary: dict
+
+    def __repr__(self):
+        s = self.summary
+        lock = "never locks" if s["engagement_time_s"] is None else f"lock-up {s['engagement_time_s']:.4g} s"
+        return (f"EngagementResult(scene={s['scene']!r}, {lock}, peak torque {s['peak_torque_Nm']:.4g} N m, "
+                f"dissipated {s['dissipated_energy_J']:.4g} J, {self.result.t.size} samples)")
+
+    def table(self):
+        """The time series as a :class:`~clutchocp.simulation.result.Table`: every column named with its
+        unit (those of timeseries.csv without the unit-less state copies), samples on the output grid
+        and at both sides of each event."""
+        return Table({name: values for name, values in self.series().items()
+                      if name == "mode" or Table({name: ()}).units[name]})
+
+    def plot(self, path=None):
+        """Overview figure: films, speeds, torque and pressure against time; PNG if ``path`` is given.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from .report import overview_figure
+        from ..output import save_figure
+        fig = overview_figure(self)
+        if path is not None:
+            save_figure(fig, path)
+        return fig
 
     def series(self):
         """Time series on the output grid and at both sides of each event: {column: array}.
@@ -46,8 +92,8 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
 
     Parameters
     ----------
-    scene : clutchocp.scene.Scene
-        An engagement scene.
+    scene : clutchocp.scene.Scene, str or pathlib.Path
+        An engagement scene, or a built-in scene name or a scene file.
     rtol, atol : float, optional
         Integration tolerances (default: the scene's [simulation] values); ``atol`` applies to
         states scaled by their nominal values.
@@ -74,6 +120,9 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     -------
     EngagementResult
     """
+    if isinstance(scene, (str, Path)):
+        scene = load_scene(scene)
+    check_run_settings(rtol=rtol, atol=atol, t_end=t_end, output_points=output_points)
     model = model or EngagementModel(scene)
     t_end = t_end or scene.value("simulation.t_end")
     n_out = output_points or scene.value("simulation.output_points")

@@ -124,6 +124,10 @@ class OptimalEngagement:
     def success(self):
         return self.stats["success"]
 
+    def __repr__(self):
+        return (f"OptimalEngagement(t_f={self.t_f:.6g} s, {self.control} command on {self.command.size} nodes, "
+                f"objective {self.objective:.6g}, {self.stats.get('status')}, {self.stats.get('iterations')} iterations)")
+
 
 class EngagementOCP:
     """The optimal engagement pressure problem of a scene, transcribed by direct collocation.

@@ -9,6 +9,7 @@ from ..errors import ClutchocpError, ModelError
 from ..output import new_figure, save_figure, shown, write_csv, write_summary, writes_folder
 from ..scene import default_scene, load_scene
 from .baselines import baseline_label, simulate_baselines
+from .outcome import OptimizationResult
 from .bound import jerk_lower_bound
 from .problem import EngagementOCP
 from .replay import CommandModel
@@ -53,11 +54,37 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         Infeasible limits, bad weights, a scene the optimisation does not cover, IPOPT failure.
     """
     say = print if progress else (lambda *a, **k: None)
+    result = optimize_scene(scene, t_max=t_max, weights=weights, intervals=intervals, degree=degree,
+                            sweep_t_max=sweep_t_max, progress=progress)
+    summary, scene, ocp, opt, replay = result.summary, result.scene, result.ocp, result.optimum, result.replay
+    out = Path(out_dir)
+    files = [_write_profile(out, ocp, opt), write_summary(out / "summary.json", summary)]
+    files += plot_optimum(out, scene, opt, replay, ocp.baseline, result.baselines, summary)
+    if "sweep" in summary:
+        files.append(plot_pareto(out, scene, summary["sweep"], summary["initial_slip_rad_s"],
+                                 summary["initial_slip_rate_rad_s2"], ocp))
+    summary["files"] = [shown(f) for f in files]
+    say(format_summary(summary))
+    return summary
+
+
+def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degree=3, sweep_t_max=None,
+                   progress=False):
+    """Solve, verify with IDAS and compare with the baselines, without writing files.
+
+    Parameters are those of :func:`run_optimize` (``scene`` may also be a name or a path).
+
+    Returns
+    -------
+    clutchocp.optimal.outcome.OptimizationResult
+        ``summary`` (as written to summary.json), the problem, the optimum, its IDAS replay and
+        the baseline runs; ``table()`` and ``plot()`` for a look.
+    """
+    say = print if progress else (lambda *a, **k: None)
     if scene is None:
         scene = default_scene()
     elif isinstance(scene, (str, Path)):
         scene = load_scene(scene)
-    out = Path(out_dir)
     start = time.perf_counter()
     say(f"optimize {scene.name}: building the collocation problem ({intervals} intervals, degree {degree})")
     ocp = EngagementOCP(scene, intervals=intervals, degree=degree)
@@ -103,14 +130,7 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     }
     if sweep is not None:
         summary["sweep"] = sweep
-    out.mkdir(parents=True, exist_ok=True)
-    files = [_write_profile(out, ocp, opt), write_summary(out / "summary.json", summary)]
-    files += plot_optimum(out, scene, opt, replay, ocp.baseline, baselines, summary)
-    if sweep is not None:
-        files.append(plot_pareto(out, scene, sweep, w_rel0, rate0, ocp))
-    summary["files"] = [shown(f) for f in files]
-    say(format_summary(summary))
-    return summary
+    return OptimizationResult(scene, summary, ocp, opt, replay, baselines)
 
 
 def _fmt(value, unit, fmt="{:.4g}"):
@@ -150,12 +170,16 @@ def _write_profile(out, ocp, opt):
     from each time on. After lock-up (the last time) the command is the holding pressure of the
     verification (summary: verification.holding_pressure_Pa; the last row of a constant command).
     """
+    return write_csv(out / "pressure_profile.csv", profile_columns(ocp, opt))
+
+
+def profile_columns(ocp, opt):
+    """The columns of pressure_profile.csv (see :func:`_write_profile`): {name with unit: array}."""
     times = np.append(opt.command_times, opt.t_f * (1 + HOLD_DELAY)) if opt.control == "constant" \
         else opt.command_times.copy()
     command = np.append(opt.command, holding_pressure(ocp, opt)) if opt.control == "constant" else opt.command
     pressure = np.interp(times, opt.t, opt.outputs["pressure_Pa"])
-    return write_csv(out / "pressure_profile.csv",
-                     {"time_s": times, "pressure_command_Pa": command, "pressure_Pa": pressure})
+    return {"time_s": times, "pressure_command_Pa": command, "pressure_Pa": pressure}
 
 
 def _slip(run):
@@ -169,20 +193,7 @@ def plot_optimum(out, scene, opt, replay, baseline, baselines, summary):
     files = []
     name = scene.name
     runs = (("optimal (IDAS replay)", replay, "C0"), (f"baseline ({summary['baseline']['profile']})", baseline, "C3"))
-
-    fig, (ax,) = new_figure()
-    if opt.control == "constant":
-        ax.step(np.append(opt.command_times, opt.t_f), np.append(opt.command, opt.command[-1]) / 1e6,
-                where="post", color="C0", lw=0.8, alpha=0.6, label="optimal command")
-    else:
-        ax.plot(opt.command_times, opt.command / 1e6, color="C0", lw=0.8, alpha=0.6, label="optimal command")
-    for label, run, color in runs:
-        ax.plot(run.result.t, run.result["pressure_Pa"] / 1e6, color=color, label=label)
-    ax.plot(opt.t, opt.outputs["pressure_Pa"] / 1e6, ".", color="C0", ms=2, label="collocation")
-    ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{name}: engagement pressure")
-    _locks(ax, runs)
-    ax.legend(fontsize=8)
-    files.append(save_figure(fig, out / "pressure.png"))
+    files.append(save_figure(pressure_figure(scene, opt, replay, baseline, summary), out / "pressure.png"))
 
     for key, ylabel, fname, title in (("total_torque_Nm", "clutch torque [N m]", "torque.png", "clutch torque"),
                                       ("output_jerk_rad_s3", "output jerk [rad/s^3]", "jerk.png", "output jerk")):
@@ -210,6 +221,24 @@ def plot_optimum(out, scene, opt, replay, baseline, baselines, summary):
     share = summary["jerk_lower_bound"] / summary["slip_jerk_lower_bound"] if summary["slip_jerk_lower_bound"] else 0.0
     files.append(plot_baselines(out, name, summary, baselines, lambda T: jerk_lower_bound(w_rel0, rate0, T) * share))
     return files
+
+
+def pressure_figure(scene, opt, replay, baseline, summary):
+    """The optimal command, its IDAS replay, the collocation points and the baseline's pressure."""
+    runs = (("optimal (IDAS replay)", replay, "C0"), (f"baseline ({summary['baseline']['profile']})", baseline, "C3"))
+    fig, (ax,) = new_figure()
+    if opt.control == "constant":
+        ax.step(np.append(opt.command_times, opt.t_f), np.append(opt.command, opt.command[-1]) / 1e6,
+                where="post", color="C0", lw=0.8, alpha=0.6, label="optimal command")
+    else:
+        ax.plot(opt.command_times, opt.command / 1e6, color="C0", lw=0.8, alpha=0.6, label="optimal command")
+    for label, run, color in runs:
+        ax.plot(run.result.t, run.result["pressure_Pa"] / 1e6, color=color, label=label)
+    ax.plot(opt.t, opt.outputs["pressure_Pa"] / 1e6, ".", color="C0", ms=2, label="collocation")
+    ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{scene.name}: engagement pressure")
+    _locks(ax, runs)
+    ax.legend(fontsize=8)
+    return fig
 
 
 def plot_baselines(out, name, summary, baselines, bound_at):

@@ -92,6 +92,19 @@ def _check_value(name, value, spec, unit_hint):
         raise PhysicalRangeError(f"{name} = {value:g}{unit_hint}: must be {phrase}")
 
 
+def check_value(name, value, spec):
+    """Check an SI value given outside a scene file (an API argument) as the scene field ``spec`` would.
+
+    Raises ParameterTypeError (not a number, or not a whole number for an int field) or
+    PhysicalRangeError (outside the field's range), naming ``name``.
+    """
+    whole = spec.kind == "int"
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or \
+            (whole and not float(value).is_integer()):
+        raise ParameterTypeError(f"{name} = {value!r}: expected {'a whole number' if whole else 'a number'}")
+    _check_value(name, float(value), spec, "" if spec.dim == "1" else f" ({spec.dim})")
+
+
 def _parse_field(name, raw, spec, density=None):
     """Convert one raw TOML value to its SI value, or raise a one-line SceneError.
 

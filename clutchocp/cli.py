@@ -52,10 +52,11 @@ def positive_float(text, *, upper=None, what="a positive number"):
 def tolerance(text):
     """An integration tolerance in :data:`TOLERANCE_RANGE`; an argparse ``type=``."""
     low, high = TOLERANCE_RANGE
-    value = positive_float(text, what=f"a tolerance from {low:g} to {high:g}")
+    allowed = "a tolerance from 1e-14 to 1e-2"
+    value = positive_float(text, what=allowed)
     if not low <= value <= high:
-        raise argparse.ArgumentTypeError(f"{text}: a tolerance from {low:g} to {high:g} is allowed (looser "
-                                         "tolerances give errors of percents without a warning)")
+        raise argparse.ArgumentTypeError(f"{text}: {allowed} is allowed (looser tolerances give errors of "
+                                         "percents without a warning)")
     return value
 
 

@@ -356,7 +356,7 @@ def validate(raw, base_dir):
 def parse_override(text):
     """Parse ``"part.key=value"`` from the command line; the value is read as TOML if it can be."""
     name, eq, value = text.partition("=")
-    if not eq:
+    if not eq or not name.strip():
         raise UnknownKeyError(f"--set {text}: write part.key=value (e.g. oil.viscosity='0.04 Pa s')")
     try:
         parsed = tomllib.loads(f"v = {value.strip()}")["v"]

@@ -1,15 +1,109 @@
 """The ``clutchocp`` command: a thin layer over the Python API.
 
 Every user mistake ends in one line on stderr naming the field and what is allowed, exit code 2.
+Ctrl-C stops the run (also inside IDAS and IPOPT) with one line and exit code 130; no output folder
+is left that looks complete (results are written through :func:`clutchocp.output.output_folder`).
+
+Helpers for the commands' options (:func:`positive_float`, :func:`tolerance`, :func:`count`,
+:func:`parse_time_list`) are argparse ``type=`` functions: a bad value ends in one line naming the
+option and what is allowed.
 """
 
 import argparse
+import math
+import os
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from .errors import ClutchocpError, ModelError
+from . import interrupt
+from .errors import ClutchocpError, OptionError
+from .output import output_folder
+
+# Integration tolerances a user may ask for: tighter than 1e-14 is below double precision noise on
+# the scaled states; looser than 1e-2 gives errors of several percent (at --rtol 10 bao2020's energy
+# balance was off by 17 %), i.e. results that only look like answers.
+TOLERANCE_RANGE = (1e-14, 1e-2)
+MAX_INTERVALS = 2000      # collocation intervals: 2000 x degree 3 is ~10^5 NLP variables (minutes, GBs)
+MAX_SWEEP_POINTS = 50     # engagement-time limits in one sweep (each is a full IPOPT solve)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (exit code 2) instead of the usage block."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+def positive_float(text, *, upper=None, what="a positive number"):
+    """A finite number > 0 (and <= ``upper``); an argparse ``type=``."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number; {what} is allowed") from None
+    if not (math.isfinite(value) and value > 0) or (upper is not None and value > upper):
+        limit = f" up to {upper:g}" if upper is not None else ""
+        raise argparse.ArgumentTypeError(f"{text}: {what}{limit} is allowed")
+    return value
+
+
+def tolerance(text):
+    """An integration tolerance in :data:`TOLERANCE_RANGE`; an argparse ``type=``."""
+    low, high = TOLERANCE_RANGE
+    allowed = "a tolerance from 1e-14 to 1e-2"
+    value = positive_float(text, what=allowed)
+    if not low <= value <= high:
+        raise argparse.ArgumentTypeError(f"{text}: {allowed} is allowed (looser tolerances give errors of "
+                                         "percents without a warning)")
+    return value
+
+
+def count(low, high, what):
+    """An argparse ``type=`` for an integer from ``low`` to ``high``."""
+    def parse(text):
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not an integer; {what} from {low} to {high}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{text}: {what} from {low} to {high} is allowed")
+        return value
+    return parse
+
+
+def time_limit(text):
+    """A positive, finite time [s]; an argparse ``type=``."""
+    return positive_float(text, what="a positive time in seconds")
+
+
+def parse_time_list(text, option):
+    """``"0.2,0.3,0.4"`` or ``"0.2:0.5:7"`` (start:stop:count) -> sorted distinct positive times [s].
+
+    Raises OptionError naming ``option`` for anything else (NaN, zero or negative times, a count
+    below 2 or above :data:`MAX_SWEEP_POINTS`, an empty list).
+    """
+    usage = f"{option} {text}: give positive times in seconds, '0.2,0.3,0.4' or start:stop:count like '0.2:0.5:7'"
+    try:
+        if ":" in text:
+            start, stop, n = text.split(":")
+            start, stop, n = float(start), float(stop), int(n)
+        else:
+            values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise OptionError(usage) from None
+    if ":" in text:
+        if not 2 <= n <= MAX_SWEEP_POINTS:
+            raise OptionError(f"{option} {text}: the count (after the second colon) must be from 2 to "
+                              f"{MAX_SWEEP_POINTS}")
+        values = np.linspace(start, stop, n)
+    if not len(values) or not all(math.isfinite(v) and v > 0 for v in values):
+        raise OptionError(usage)
+    values = sorted({float(v) for v in values})
+    if len(values) > MAX_SWEEP_POINTS:
+        raise OptionError(f"{option} {text}: at most {MAX_SWEEP_POINTS} times (each is a full solve)")
+    return values
 
 
 def _cmd_scenes(args):
@@ -47,7 +141,7 @@ def _describe(scene):
 def _cmd_validate(args):
     from .analyses import run_validation
 
-    run_validation(Path(args.out))
+    run_validation(args.out)
     return 0
 
 
@@ -58,9 +152,10 @@ def _cmd_simulate(args):
 
     overrides = dict(parse_override(text) for text in args.set)
     scene = load_scene(args.scene, overrides=overrides)
-    run = simulate_engagement(scene, rtol=args.rtol, atol=args.atol, method=args.method, native=args.native)
-    print(format_summary(run.summary))
-    files = write_engagement(run, args.out)
+    with output_folder(args.out) as folder:
+        run = simulate_engagement(scene, rtol=args.rtol, atol=args.atol, method=args.method, native=args.native)
+        print(format_summary(run.summary))
+        files = write_engagement(run, folder.path)
     print(f"wrote {len(files)} files to {args.out}: {', '.join(f.name for f in files)}")
     return 0
 
@@ -91,39 +186,36 @@ def _cmd_control(args):
     return 0
 
 
-def _parse_weights(text):
-    """``"jerk=1,energy=0.1"`` -> {"jerk": 1.0, "energy": 0.1}."""
+def parse_weights(text, option="--weights"):
+    """``"jerk=1,energy=0.1"`` -> {"jerk": 1.0, "energy": 0.1} (names and values checked by the solver)."""
+    usage = f"{option} {text!r}: write name=number pairs separated by commas, e.g. jerk=1,energy=0.1"
     weights = {}
-    for item in filter(None, (part.strip() for part in text.split(","))):
+    for item in (part.strip() for part in text.split(",")):
         name, eq, value = item.partition("=")
         try:
-            weights[name.strip()] = float(value)
+            number = float(value)
         except ValueError:
-            eq = ""
-        if not eq:
-            raise ModelError(f"--weights {text}: write name=number pairs separated by commas, e.g. jerk=1,energy=0.1")
+            raise OptionError(usage) from None
+        if not eq or not name.strip():
+            raise OptionError(usage)
+        if name.strip() in weights:
+            raise OptionError(f"{option} {text!r}: '{name.strip()}' is given twice")
+        weights[name.strip()] = number
+    if not weights:
+        raise OptionError(usage)
     return weights
 
 
-def _parse_sweep(text):
-    """``"0.2,0.3,0.4"`` or ``"0.2:0.5:7"`` (start:stop:count) -> list of engagement-time limits [s]."""
-    try:
-        if ":" in text:
-            start, stop, count = text.split(":")
-            return [float(v) for v in np.linspace(float(start), float(stop), int(count))]
-        return [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise ModelError(f"--sweep-t-max {text}: give limits in seconds, '0.2,0.3,0.4' or start:stop:count "
-                         "like '0.2:0.5:7'") from None
-
-
 def _cmd_optimize(args):
+    from .optimal.problem import check_weights
     from .optimal.report import run_optimize
 
-    run_optimize(args.scene, out_dir=args.out, t_max=args.t_max,
-                 weights=_parse_weights(args.weights) if args.weights else None,
-                 intervals=args.intervals, degree=args.degree,
-                 sweep_t_max=_parse_sweep(args.sweep_t_max) if args.sweep_t_max else None,
+    weights = parse_weights(args.weights) if args.weights is not None else None
+    if weights is not None:
+        check_weights(weights)             # before any solving
+    sweep = parse_time_list(args.sweep_t_max, "--sweep-t-max") if args.sweep_t_max is not None else None
+    run_optimize(args.scene, out_dir=args.out, t_max=args.t_max, weights=weights,
+                 intervals=args.intervals, degree=args.degree, sweep_t_max=sweep,
                  max_temperature_C=args.max_temperature, max_specific_power_W_mm2=args.max_specific_power)
     return 0
 
@@ -131,14 +223,14 @@ def _cmd_optimize(args):
 def _cmd_bench(args):
     from .bench import format_summary, run_bench
 
-    summary = run_bench(Path(args.out), quick=args.quick, progress=True)
+    summary = run_bench(args.out, quick=args.quick, progress=True)
     print(format_summary(summary))
     return 0
 
 
 def build_parser():
     """The argument parser of the ``clutchocp`` command."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="clutchocp",
         description="Wet-clutch and hydro-viscous-drive simulation, optimal engagement pressure and control.",
     )
@@ -151,11 +243,13 @@ def build_parser():
     p.set_defaults(run=_cmd_validate)
     p = sub.add_parser("simulate", help="simulate an engagement scene through impact and lock-up (IDAS)")
     p.add_argument("scene", help="scene name (see 'clutchocp scenes') or TOML file")
-    p.add_argument("--out", default="out/simulate", help="output folder (default: out/simulate)")
+    p.add_argument("--out", default="out/simulate", help="output folder (default: out/simulate); written when complete")
     p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
                    help="override a scene value, e.g. --set oil.viscosity='0.04 Pa s' (repeatable)")
-    p.add_argument("--rtol", type=float, default=None, help="relative tolerance (default: the scene's)")
-    p.add_argument("--atol", type=float, default=None, help="absolute tolerance on scaled states")
+    p.add_argument("--rtol", type=tolerance, default=None,
+                   help="relative tolerance, 1e-14 ... 1e-2 (default: the scene's simulation.rtol)")
+    p.add_argument("--atol", type=tolerance, default=None,
+                   help="absolute tolerance on the states scaled by their nominal values, 1e-14 ... 1e-2")
     p.add_argument("--method", default="idas", choices=("idas", "Radau", "BDF", "LSODA"),
                    help="integrator (default: idas)")
     p.add_argument("--native", action="store_true",
@@ -176,11 +270,17 @@ def build_parser():
     p = sub.add_parser("optimize", help="optimal engagement pressure by direct collocation (the main job)")
     p.add_argument("scene", nargs="?", default=None, help="engagement scene (default: the default scene)")
     p.add_argument("--out", default="out/optimize", help="output folder (default: out/optimize)")
-    p.add_argument("--t-max", type=float, default=None, help="largest engagement time [s]")
+    p.add_argument("--t-max", type=time_limit, default=None, help="largest engagement time [s]")
     p.add_argument("--weights", default=None, metavar="NAME=W,...",
-                   help="objective weights, e.g. jerk=1,energy=0.1,time=0,jump=1")
-    p.add_argument("--intervals", type=int, default=100, help="collocation intervals (default: 100)")
-    p.add_argument("--degree", type=int, default=3, help="collocation points per interval (default: 3)")
+                   help="objective weights; the objective is jerk*J/J_ref + energy*E/E_ref + time*T/T_ref "
+                        "+ jump*(jump/M_ref)^2 + smooth*S/S_ref, each term scaled to about 1 on the "
+                        "scene's baseline (see README). Defaults: jerk=1, energy=0, time=0, jump=0, "
+                        "smooth=0.1 (a penalty on the command's rate that keeps the command smooth; set "
+                        "smooth=0 when time or energy is the goal). Names not given keep their default")
+    p.add_argument("--intervals", type=count(2, MAX_INTERVALS, "collocation intervals"), default=100,
+                   help=f"collocation intervals, 2 ... {MAX_INTERVALS} (default: 100)")
+    p.add_argument("--degree", type=count(1, 9, "collocation points per interval"), default=3,
+                   help="collocation points per interval, 1 ... 9 (default: 3)")
     p.add_argument("--sweep-t-max", default=None, metavar="LIST|START:STOP:COUNT",
                    help="solve for several engagement-time limits and draw the jerk/time trade-off")
     p.add_argument("--max-temperature", type=float, default=None, metavar="DEGC",
@@ -201,16 +301,43 @@ def build_parser():
 
 
 def main(argv=None):
-    """Entry point; returns the process exit code."""
-    args = build_parser().parse_args(argv)
+    """Entry point; returns the process exit code.
+
+    0: done; 2: a user mistake or a solver failure (one line on stderr naming the field and what
+    is allowed, or when, where and why the solver stopped);
+    130: interrupted by Ctrl-C (one line; no output folder was put in place); 1: a system failure
+    or an unexpected error (one line; ``CLUTCHOCP_DEBUG=1`` shows the traceback).
+    """
+    name = "clutchocp"
     try:
-        return args.run(args)
-    except ClutchocpError as exc:
-        print(f"clutchocp {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("clutchocp: interrupted", file=sys.stderr)
+        with interrupt.catch_interrupts(), warnings.catch_warnings():
+            warnings.showwarning = lambda message, *rest, **kw: print(
+                f"{name}: warning: {' '.join(str(message).split())}", file=sys.stderr)
+            args = build_parser().parse_args(argv)
+            name = f"clutchocp {args.command}"
+            code = args.run(args)
+            interrupt.check()
+            return code
+    except SystemExit as exc:            # argparse: --help (0) or a bad option (2, already printed)
+        return exc.code if isinstance(exc.code, int) else 2
+    except KeyboardInterrupt as exc:
+        where = str(exc) if isinstance(exc, interrupt.UserInterrupt) and str(exc) else "interrupted by the user"
+        print(f"{name}: {where}; stopped, no results written", file=sys.stderr)
         return 130
+    except ClutchocpError as exc:
+        print(f"{name}: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"{name}: error: {exc.strerror or exc}{': ' + str(exc.filename) if exc.filename else ''}",
+              file=sys.stderr)
+        return 1
+    except Exception as exc:  # noqa: BLE001 - a bug: one line unless debugging
+        if os.environ.get("CLUTCHOCP_DEBUG"):
+            raise
+        text = " ".join(str(exc).split())[:300]
+        print(f"{name}: internal error ({type(exc).__name__}: {text}); please report it "
+              "(CLUTCHOCP_DEBUG=1 shows the traceback)", file=sys.stderr)
+        return 1
 
 
 

@@ -55,3 +55,15 @@ class ModelError(ClutchocpError, ValueError):
 
 class SolverError(ClutchocpError, RuntimeError):
     """A numerical solver failed; the message says when, where and why."""
+
+
+class OptionError(ClutchocpError, ValueError):
+    """A command-line option or API argument has a value that is not allowed."""
+
+
+class OutputFolderError(ClutchocpError, ValueError):
+    """An output folder that cannot be written (a file, an unwritable parent, in use by another run)."""
+
+
+class ResourceLimitError(SceneError):
+    """A size (output points, plate interfaces ...) beyond what a run can hold in memory and time."""

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from clutchocp.analyses import chen2021, cui2019, liao2021
 from clutchocp.analyses.report import format_table
-from clutchocp.output import nest, write_summary
+from clutchocp.output import nest, shown, write_summary, writes_folder
 
 __all__ = ["run_validation", "ANALYSES"]
 
@@ -20,6 +20,7 @@ __all__ = ["run_validation", "ANALYSES"]
 ANALYSES = (chen2021, cui2019, liao2021)
 
 
+@writes_folder
 def run_validation(out_dir, *, quiet=False):
     """Run every static analysis on its built-in scene and write the results.
 
@@ -47,5 +48,5 @@ def run_validation(out_dir, *, quiet=False):
     if not quiet:
         print(format_table(results))
         files = [f.name for res in results for f in res.files] + [path.name]
-        print(f"wrote {len(files)} files to {out_dir}: {', '.join(files)}")
+        print(f"wrote {len(files)} files to {shown(out_dir)}: {', '.join(files)}")
     return summary

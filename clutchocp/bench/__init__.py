@@ -1,4 +1,4 @@
-"""Benchmarks: how far to trust a result (issue 6).
+"""Benchmarks: how far to trust a result, and how fast IDAS is against its peers at matched error.
 
 * :func:`run_bench` -- the ``clutchocp bench`` command: work-precision of IDAS against CVODES and
   scipy's Radau, BDF and LSODA, stiffness along each trajectory, run time against pack size and

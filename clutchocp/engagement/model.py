@@ -378,7 +378,14 @@ class EngagementModel:
         out["total_torque_Nm"] = T_clutch
         out["static_capacity_Nm"] = capacity
         out["contact_force_N"] = sum(film.contact_force(hi) for hi in h) / n
+        for i in range(n):
+            # per film: the oil's share of the film load W = K (-dh/dt) + S (Bao Eq. 12-13) and the
+            # closing speed; int sum(force x speed) dt is E_film, so the CSV alone closes the balance
+            out[f"film_{i + 1}_fluid_force_N"] = K[i] * (-dh[i]) + S[i] - film.contact_force(h[i])
+            out[f"film_{i + 1}_closing_speed_m_s"] = -dh[i]
         out["pack_force_N"] = face_force
+        if self.has_piston:
+            out["piston_force_N"] = F_drive          # springs and pressure on the piston (net drive)
         out["output_acceleration_rad_s2"] = a_out
         out["output_jerk_rad_s3"] = jerk
         out["dissipated_power_W"] = rate["E_slip"] + film_fluid_power + seal_power + spline_power + shaft_power

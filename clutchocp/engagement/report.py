@@ -3,6 +3,8 @@
 from pathlib import Path
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
 from ..output import new_figure, save_figure, write_csv, write_summary
 from .run import pressure_rise_time
@@ -32,14 +34,30 @@ def write_engagement(run, out_dir):
     return files
 
 
-def _finish(fig, ax, run, path, legend=True):
-    """Mark the lock-up time, add the legend and save the figure; returns its path."""
+def _mark_lockup(ax, run):
+    """A dashed line at the lock-up time, in the legend as 'lock-up at ... s'."""
     t_lock = run.summary["engagement_time_s"]
     if t_lock is not None:
-        ax.axvline(t_lock, color="0.5", lw=0.8, ls="--", label="lock-up")
+        ax.axvline(t_lock, color="0.5", lw=0.8, ls="--", label=f"lock-up at {t_lock:.4g} s")
+
+
+def _finish(fig, ax, run, path, legend=True):
+    """Mark the lock-up time, add the legend and save the figure; returns its path."""
+    _mark_lockup(ax, run)
     if legend:
         ax.legend(fontsize=8)
     return save_figure(fig, path)
+
+
+def _early_window(t, values, fraction=0.99):
+    """End of the early transient [s]: when every series has made ``fraction`` of its total change."""
+    ends = []
+    for y in values:
+        change = np.abs(y - y[0])
+        total = change[-1] if change[-1] > 0 else change.max()
+        if total > 0:
+            ends.append(t[np.argmax(change >= fraction * total)])
+    return max(ends) if ends else t[-1]
 
 
 def plot_engagement(run, out):
@@ -48,11 +66,20 @@ def plot_engagement(run, out):
     t = res.t
     files = []
 
-    fig, (ax,) = new_figure()
-    for i in range(model.n):
-        ax.plot(t, res[f"h_{i + 1}_m"] * 1e6, label=f"film {i + 1}")
-    ax.set(xlabel="time [s]", ylabel="film thickness [um]", title=f"{name}: oil films")
-    ax.set_yscale("log")
+    # films: the squeeze phase is often a few % of the run, so the left panel shows it alone
+    films = [res[f"h_{i + 1}_m"] * 1e6 for i in range(model.n)]
+    t_early = min(1.5 * _early_window(t, films), t[-1])
+    fig, (ax0, ax) = new_figure(2, width=5.0)
+    for ax_ in (ax0, ax):
+        for i, h in enumerate(films):
+            ax_.plot(t, h, label=f"film {i + 1}")
+        ax_.set_yscale("log")
+        ax_.grid(alpha=0.3, which="both")
+    ax0.set(xlabel="time [s]", ylabel="film thickness [um]", xlim=(t[0], t_early),
+            title=f"{name}: oil films, first {t_early:.3g} s")
+    ax.set(xlabel="time [s]", ylabel="film thickness [um]", title="whole run")
+    _mark_lockup(ax0, run)
+    ax0.legend(fontsize=8)
     files.append(_finish(fig, ax, run, out / "gaps.png"))
 
     fig, (ax,) = new_figure()
@@ -68,10 +95,25 @@ def plot_engagement(run, out):
     ax.set(xlabel="time [s]", ylabel="clutch torque [N m]", title=f"{name}: torque components")
     files.append(_finish(fig, ax, run, out / "torque.png"))
 
-    fig, (ax,) = new_figure()
-    ax.plot(t, res["pressure_Pa"] / 1e6)
-    ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{name}: engagement pressure")
-    files.append(_finish(fig, ax, run, out / "pressure.png", legend=False))
+    # pressure and the force that presses the pack: for a spring-applied clutch the pressure
+    # (the release pressure) may stay zero while the springs press the plates
+    fig, (ax0, ax) = new_figure(2, width=5.0)
+    ax0.plot(t, res["pressure_Pa"] / 1e6, label="pressure")
+    ax0.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{name}: actuation pressure")
+    if model.has_piston and model.scene.variant("piston") == "spring_applied":
+        ax0.set_title(f"{name}: release pressure (spring-applied piston)")
+    if not np.any(res["pressure_Pa"]):
+        ax0.text(0.5, 0.6, "the pressure stays 0:\nthe springs engage the clutch\n(force: right panel)",
+                 transform=ax0.transAxes, ha="center", fontsize=9)
+    if model.has_piston:
+        ax.plot(t, res["piston_force_N"] / 1e3, color="C2", label="piston drive (springs and pressure)")
+    else:
+        ax.plot(t, res["pack_force_N"] / 1e3, color="C2", label="pressure force on the pack")
+    ax.plot(t, res["contact_force_N"] / 1e3, color="C1", lw=1, label="asperity contact (each film carries it)")
+    ax.set(xlabel="time [s]", ylabel="force [kN]", title="force pressing the plates")
+    _mark_lockup(ax0, run)
+    ax0.legend(fontsize=8)
+    files.append(_finish(fig, ax, run, out / "pressure.png"))
     if run.summary["torque_response_time_stable_s"] is not None:
         files.append(plot_torque_response(run, out / "torque_response.png"))
     files.append(plot_heat(run, out / "heat.png"))
@@ -137,6 +179,38 @@ def plot_heat(run, path):
             hot.axvline(summary["engagement_time_s"], color="0.5", lw=0.8, ls="--", label="lock-up")
         hot.legend(fontsize=8)
     return _finish(fig, ax, run, path)
+
+
+def overview_figure(run):
+    """One figure of a run (``EngagementResult.plot``): films, speeds, clutch torque and pressure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    res, model, name = run.result, run.model, run.summary["scene"]
+    t = res.t
+    fig = Figure(figsize=(11.0, 7.0), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = [fig.add_subplot(2, 2, k + 1) for k in range(4)]
+    for i in range(model.n):
+        axes[0].plot(t, res[f"h_{i + 1}_m"] * 1e6, label=f"film {i + 1}")
+    axes[0].set(ylabel="film thickness [um]", yscale="log", title=f"{name}: oil films")
+    axes[1].plot(t, res["w_in_rad_s"], label="input")
+    axes[1].plot(t, res["w_out_rad_s"], label="output")
+    axes[1].set(ylabel="speed [rad/s]", title="speeds")
+    axes[2].plot(t, res["viscous_torque_Nm"], label="viscous")
+    axes[2].plot(t, res["contact_torque_Nm"], label="asperity contact")
+    axes[2].plot(t, res["total_torque_Nm"], "k", lw=1.5, label="total")
+    axes[2].set(ylabel="clutch torque [N m]", title="torque")
+    axes[3].plot(t, res["pressure_Pa"] / 1e6, label="pressure")
+    axes[3].set(ylabel="pressure [MPa]", title="actuation pressure")
+    for ax in axes:
+        ax.set_xlabel("time [s]")
+        ax.grid(alpha=0.3)
+        _mark_lockup(ax, run)
+        ax.legend(fontsize=7)
+    return fig
 
 
 def format_summary(summary):

@@ -2,31 +2,86 @@
 
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from ..errors import ModelError, SolverError
+from ..simulation.result import Table
 from ..simulation import SimulationOptions, simulate
+from ..simulation.locate import crossing_time, peak
+from ..scene import load_scene
+from ..scene.loader import check_value
 from .model import ENERGY_TERMS, EngagementModel
 
 
-@dataclass
+def check_run_settings(**settings):
+    """Check rtol, atol, t_end and output_points given to a run as the scene's [simulation] values are.
+
+    None means "the scene's value". Raises a PhysicalRangeError naming the argument.
+    """
+    from ..scene.schema import PARTS
+    fields = PARTS["simulation"].fields
+    for name, value in settings.items():
+        if value is not None:
+            check_value(name, value, fields[name])
+
+
+@dataclass(repr=False)
 class EngagementResult:
-    """An engagement run: the model, the raw hybrid result and its summary (``summary`` is JSON-ready)."""
+    """An engagement run: the model, the raw hybrid result and its summary (``summary`` is JSON-ready).
+
+    ``table()`` gives the time series with units, ``plot()`` an overview figure.
+    """
 
     model: EngagementModel
     result: object
     summary: dict
 
+    def __repr__(self):
+        s = self.summary
+        lock = "never locks" if s["engagement_time_s"] is None else f"lock-up {s['engagement_time_s']:.4g} s"
+        return (f"EngagementResult(scene={s['scene']!r}, {lock}, peak torque {s['peak_torque_Nm']:.4g} N m, "
+                f"dissipated {s['dissipated_energy_J']:.4g} J, {self.result.t.size} samples)")
+
+    def table(self):
+        """The time series as a :class:`~clutchocp.simulation.result.Table`: every column named with its
+        unit (those of timeseries.csv without the unit-less state copies), samples on the output grid
+        and at both sides of each event."""
+        return Table({name: values for name, values in self.series().items()
+                      if name == "mode" or Table({name: ()}).units[name]})
+
+    def plot(self, path=None):
+        """Overview figure: films, speeds, torque and pressure against time; PNG if ``path`` is given.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from .report import overview_figure
+        from ..output import save_figure
+        fig = overview_figure(self)
+        if path is not None:
+            save_figure(fig, path)
+        return fig
+
     def series(self):
-        """Time series on the output grid and at both sides of each event: {column: array}."""
+        """Time series on the output grid and at both sides of each event: {column: array}.
+
+        Besides the states and outputs, the energy accumulators E_x of the run are columns
+        ``x_energy_J`` (work or energy since t = 0 [J]): with ``kinetic_energy_J`` and
+        ``spring_energy_J`` they close the energy balance from the table alone (a transient of
+        microseconds, bao2020's plate impact, is not resolved by any output grid).
+        """
         res = self.result
         columns = {"time_s": res.t, "mode": res.mode}
         for name in self.model.state_names:
             if not name.startswith("E_"):
                 columns[name] = res[name]
+        for name in self.model.energy_terms:
+            columns[f"{name[2:]}_energy_J"] = res[name]
         for name in res.names():
-            if name.endswith(("_m", "_Pa", "_rad_s", "_Nm", "_N", "_rad_s2", "_rad_s3", "_W", "_J", "_C")):
+            if name.endswith(("_m", "_m_s", "_Pa", "_rad_s", "_Nm", "_N", "_rad_s2", "_rad_s3", "_W", "_J", "_C")):
                 columns[name] = res[name]
         columns["specific_power_W_mm2"] = res["interface_heat_power_W"] / self.summary["friction_area_mm2"]
         return columns
@@ -38,8 +93,8 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
 
     Parameters
     ----------
-    scene : clutchocp.scene.Scene
-        An engagement scene.
+    scene : clutchocp.scene.Scene, str or pathlib.Path
+        An engagement scene, or a built-in scene name or a scene file.
     rtol, atol : float, optional
         Integration tolerances (default: the scene's [simulation] values); ``atol`` applies to
         states scaled by their nominal values.
@@ -69,6 +124,9 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     -------
     EngagementResult
     """
+    if isinstance(scene, (str, Path)):
+        scene = load_scene(scene)
+    check_run_settings(rtol=rtol, atol=atol, t_end=t_end, output_points=output_points)
     model = model or EngagementModel(scene)
     t_end = t_end or scene.value("simulation.t_end")
     n_out = output_points or scene.value("simulation.output_points")
@@ -133,24 +191,24 @@ def explain_failure(model, err):
     return new
 
 
-def _first_crossing(t, y, level):
-    """First time y reaches ``level`` (linear interpolation), or None."""
-    above = np.nonzero(y >= level)[0]
-    if above.size == 0:
-        return None
-    k = above[0]
-    if k == 0:
-        return float(t[0])
-    return float(t[k - 1] + (level - y[k - 1]) * (t[k] - t[k - 1]) / (y[k] - y[k - 1]))
+def pieces(result):
+    """Label of each sample: the index of its segment (one mode between two events)."""
+    return np.concatenate([np.full(seg.t.size, i) for i, seg in enumerate(result.segments)])
+
+
+def _first_crossing(t, y, level, piece=None):
+    """First time y reaches ``level``, located on the local cubic of the samples (or None)."""
+    return crossing_time(t, y, level, piece=piece)
 
 
 def pressure_rise_time(model, result, fraction):
-    """First time [s] the pressure has risen by ``fraction`` of the way to the set pressure, or None."""
+    """First time [s] the pressure has risen by ``fraction`` of the way to the set pressure (located on
+    the local cubic of the samples), or None."""
     p_set = model.scene.value("actuation.pressure")
     p0 = model.scene.value("actuation.initial_pressure")
     if p_set == p0:
         return None
-    return _first_crossing(result.t, (result["pressure_Pa"] - p0) / (p_set - p0), fraction)
+    return _first_crossing(result.t, (result["pressure_Pa"] - p0) / (p_set - p0), fraction, pieces(result))
 
 
 def _slipping(result):
@@ -165,14 +223,15 @@ def response_times(model, result):
     50 % of the set pressure to 90 % of the largest slipping torque (viscous + asperity). Zhang's
     own definition, to the stable torque, is :func:`stable_torque_response`.
     """
-    t = result.t
+    t, piece = result.t, pieces(result)
     t10, t50, t90 = (pressure_rise_time(model, result, frac) for frac in (0.1, 0.5, 0.9))
     pressure_time = t90 - t10 if t10 is not None and t90 is not None else None
     slipping = _slipping(result)
     torque = np.abs(result["total_torque_Nm"])
     torque_time = None
     if t50 is not None and slipping.any():
-        t90_torque = _first_crossing(t[slipping], torque[slipping], 0.9 * torque[slipping].max())
+        t90_torque = _first_crossing(t[slipping], torque[slipping],
+                                     0.9 * peak(t[slipping], torque[slipping], piece[slipping])[0], piece[slipping])
         if t90_torque is not None:
             torque_time = t90_torque - t50
     return pressure_time, torque_time
@@ -204,7 +263,7 @@ def stable_torque_response(model, result):
     t50 = pressure_rise_time(model, result, 0.5)
     if stable <= 0 or t50 is None:
         return (stable if stable > 0 else None), None
-    t90 = _first_crossing(t, contact_torque, 0.9 * stable)
+    t90 = _first_crossing(t, contact_torque, 0.9 * stable, pieces(result)[slipping])
     return stable, (t90 - t50 if t90 is not None else None)
 
 
@@ -255,7 +314,7 @@ def summarize(model, result, wall_time, options, method):
         "scene": model.scene.name,
         "engagement_time_s": t_lock,
         "lockup_torque_jump_Nm": jump,
-        "peak_torque_Nm": float(np.max(np.abs(result["total_torque_Nm"]))),
+        "peak_torque_Nm": peak(result.t, np.abs(result["total_torque_Nm"]), pieces(result))[0],
         "peak_jerk_rad_s3": float(np.max(np.abs(jerk[np.isfinite(jerk)]))),
         "dissipated_energy_J": energy["dissipated_J"],
         "energy_balance_rel_error": energy["rel_error"],

@@ -21,6 +21,7 @@ where u_op and x_op are the steady state at the reference (trim scheduling; u_op
 python-control on the discrete loop; the PI targets of the spec are enforced.
 """
 
+import warnings
 from dataclasses import dataclass, field
 
 import control
@@ -83,6 +84,11 @@ def pressure_limits(model, spec):
     """Valve limits: the scene's range, narrowed by the spec if it says so [Pa]."""
     lo = model.p_min if spec.pressure_min is None else max(model.p_min, spec.pressure_min)
     hi = model.p_max if spec.pressure_max is None else min(model.p_max, spec.pressure_max)
+    for key, value, valve, outside in (("pressure_max", spec.pressure_max, model.p_max, lambda v: v > model.p_max),
+                                       ("pressure_min", spec.pressure_min, model.p_min, lambda v: v < model.p_min)):
+        if value is not None and outside(value):
+            warnings.warn(f"controller.{key} = {value:g} Pa is outside the valve's range (hvd.{key} = {valve:g} Pa "
+                          f"of scene '{model.scene.name}'); the valve's limit {valve:g} Pa is used", stacklevel=2)
     if lo >= hi:
         raise ModelError(f"controller pressure limits {lo:g}..{hi:g} Pa leave no range inside the valve range "
                          f"{model.p_min:g}..{model.p_max:g} Pa of the scene")
@@ -147,7 +153,13 @@ def state_scales(model, p_lo, p_hi):
 
 def lqr_gain(A, B, Q, R):
     """Discrete LQR state-feedback gain K (u = -K x) minimising sum x'Qx + u'Ru (python-control dlqr)."""
-    K, _, _ = control.dlqr(np.atleast_2d(A), np.atleast_2d(B), np.atleast_2d(Q), np.atleast_2d(R))
+    try:
+        K, _, _ = control.dlqr(np.atleast_2d(A), np.atleast_2d(B), np.atleast_2d(Q), np.atleast_2d(R))
+    except (np.linalg.LinAlgError, ValueError) as exc:
+        raise ModelError(f"controller [lqi] weights: the LQR problem has no solution ({exc}); use weights of "
+                         "similar size (speed_weight, integral_weight, input_weight within 1e-6 ... 1e6)") from None
+    if not np.all(np.isfinite(K)):
+        raise ModelError("controller [lqi] weights: the LQR gain is not finite; use weights of similar size")
     return np.atleast_2d(np.asarray(K))
 
 

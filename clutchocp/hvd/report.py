@@ -14,12 +14,12 @@ from pathlib import Path
 
 import control
 import numpy as np
-from matplotlib.ticker import FormatStrFormatter, NullFormatter
+from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
 
-from ..output import new_figure, save_figure, write_csv, write_summary
+from ..output import new_figure, save_figure, shown, write_csv, write_summary, writes_folder
 from ..scene import Scene, load_scene
 from .closed_loop import make_scenario, simulate_closed_loop
-from .design import design, frequency_response
+from .design import design, frequency_response, pressure_limits
 from .model import HvdModel
 from .spec import ControllerSpec, load_controller
 from .steady import static_map
@@ -27,6 +27,7 @@ from .steady import static_map
 DEFAULT_CONTROLLER = "lqi"
 
 
+@writes_folder
 def run_control(scene, controller=None, out_dir="out/control", verbose=True):
     """Design and check a speed controller for an HVD scene; write the report files.
 
@@ -60,10 +61,10 @@ def run_control(scene, controller=None, out_dir="out/control", verbose=True):
     summary["wall_time_s"] = time.perf_counter() - wall
     files = [write_summary(out / "summary.json", summary)]
     files += _write_tables(out, model, sched, run, data)
-    files += _figures(out, model, spec, sched, run, data)
+    files += _figures(out, model, spec, sched, run, data, scenario)
     if verbose:
         print(format_summary(summary))
-        print(f"wrote {len(files)} files to {out}: {', '.join(f.name for f in files)}")
+        print(f"wrote {len(files)} files to {shown(out)}: {', '.join(f.name for f in files)}")
     return summary
 
 
@@ -189,7 +190,7 @@ def _write_tables(out, model, sched, run, data):
     return files
 
 
-def _figures(out, model, spec, sched, run, data):
+def _figures(out, model, spec, sched, run, data, scenario):
     files = []
     rated = model.rated_speed
     # static map
@@ -199,14 +200,15 @@ def _figures(out, model, spec, sched, run, data):
     a1.plot(data["pressure_Pa"][inside] / 1e6, data["speed_rad_s"][inside] / rated * 100, "-", lw=2, label="in range")
     a1.plot([p.point.pressure / 1e6 for p in sched.points], [100 * p.point.speed / rated for p in sched.points],
             "ko", mfc="none", label="scheduled points")
-    for lim in (model.p_min, model.p_max):
-        a1.axvline(lim / 1e6, color="0.5", ls=":", lw=0.8)
+    for k, lim in enumerate((model.p_min, model.p_max)):
+        a1.axvline(lim / 1e6, color="0.5", ls=":", lw=0.8, label="valve limits" if k == 0 else None)
     a1.set(xlabel="control pressure [MPa]", ylabel="output speed [% rated]", title=f"{model.scene.name}: static map")
     a1.legend(fontsize=8)
     a2.plot(data["film_ratio"], data["viscous_torque_Nm"], label="viscous")
     a2.plot(data["film_ratio"], data["contact_torque_Nm"], label="asperity")
     a2.set_xscale("log")
-    a2.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+    a2.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))   # a log axis over less than a decade
+    a2.xaxis.set_major_formatter(FormatStrFormatter("%g"))            # showed one label only
     a2.xaxis.set_minor_formatter(NullFormatter())
     a2.set(xlabel="film ratio h/sigma [-] (first film)", ylabel="torque [N m]", title="viscous to mixed friction")
     a2.legend(fontsize=8)
@@ -248,13 +250,23 @@ def _figures(out, model, spec, sched, run, data):
     axes[0].legend(fontsize=8)
     axes[1].plot(s["t"], s["command"] / 1e6, label="command")
     axes[1].plot(s["t"], s["p"] / 1e6, label="valve pressure")
+    p_lo, p_hi = pressure_limits(model, spec)
+    axes[1].axhline(p_hi / 1e6, color="C3", ls="--", lw=0.8, label=f"valve limits {p_lo / 1e6:.3g} / {p_hi / 1e6:.3g} MPa")
+    axes[1].axhline(p_lo / 1e6, color="C3", ls="--", lw=0.8)
     axes[1].set(xlabel="time [s]", ylabel="pressure [MPa]", title="control pressure")
     axes[1].legend(fontsize=8)
     for name in model.film_names:
         axes[2].semilogy(s["t"], s[name] * 1e6, label=name)
     axes[2].set(xlabel="time [s]", ylabel="film [um]", title="film thickness")
+    step = spec.scenario["load_step"]
     for ax in axes:
         ax.grid(alpha=0.3)
+        for k, t_step in enumerate(scenario.load_times):
+            ax.axvline(t_step, color="0.3", ls=":", lw=1.0,
+                       label=f"load steps: +{100 * step:g} %, then -{100 * step:g} % of the fan torque" if k == 0
+                       else None)
+    for ax in axes[:2]:
+        ax.legend(fontsize=7)
     files.append(save_figure(fig, out / "closed_loop.png"))
     return files
 

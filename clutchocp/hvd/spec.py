@@ -56,11 +56,11 @@ _CONTROLLER = {
     "pressure_max": ("Pa", "positive", None),
 }
 _LQI = {
-    "speed_weight": ("1", "nonnegative", 1.0),
-    "pressure_weight": ("1", "nonnegative", 0.0),
-    "film_weight": ("1", "nonnegative", 0.0),
-    "integral_weight": ("1", "positive", 1.0),
-    "input_weight": ("1", "positive", 1.0),
+    "speed_weight": ("1", "weight", 1.0),
+    "pressure_weight": ("1", "weight", 0.0),
+    "film_weight": ("1", "weight", 0.0),
+    "integral_weight": ("1", "positive_weight", 1.0),
+    "input_weight": ("1", "positive_weight", 1.0),
 }
 _PI = {
     "method": ("choice", ("loop_shaping", "pole_placement"), "loop_shaping"),
@@ -87,6 +87,12 @@ _CHECKS = {
     "fraction": (lambda v: 0 < v < 1, "in (0, 1)"),
     "angle": (lambda v: 0 < v < math.pi / 2, "in (0, 90) deg"),
     "above_one": (lambda v: v > 1, "> 1"),
+    # LQI weights act on states scaled to about 1; beyond a ratio of 1e12 between two weights the
+    # Riccati equation cannot be solved in double precision (integral_weight = 1e300 failed in LAPACK)
+    "weight": (lambda v: 0 <= v <= 1e6, "in [0, 1e6] (weights on scaled states; larger ones make the LQR "
+                                        "problem numerically singular)"),
+    "positive_weight": (lambda v: 1e-6 <= v <= 1e6, "in [1e-6, 1e6] (weights on scaled states; others make "
+                                                    "the LQR problem numerically singular)"),
 }
 
 

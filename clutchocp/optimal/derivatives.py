@@ -26,6 +26,7 @@ import casadi as ca
 import numpy as np
 from scipy import sparse
 
+from .. import interrupt
 from ..errors import ModelError
 
 IPOPT_OPTIONS = {"print_level": 0, "sb": "yes", "tol": 1e-8, "max_iter": 500,
@@ -60,8 +61,9 @@ def nlp_solver(tr, *, warm=False, name="ocp", derivatives=None, ipopt=None):
     """
     options = dict(IPOPT_OPTIONS, **(WARM_OPTIONS if warm else {}), **(ipopt or {}))
     derivatives = derivatives or structured_derivatives(tr)
+    # the iteration callback stops IPOPT at the next iteration after a Ctrl-C (clutchocp.interrupt)
     return ca.nlpsol(name, "ipopt", tr.nlp, {"print_time": False, "ipopt": options, "error_on_fail": False,
-                                             **derivatives})
+                                             "iteration_callback": interrupt.ipopt_callback(), **derivatives})
 
 
 def structured_derivatives(tr):

@@ -7,9 +7,10 @@ import numpy as np
 
 from ..engagement.report import plot_heat
 from ..errors import ClutchocpError, ModelError
-from ..output import new_figure, save_figure, write_csv, write_summary
+from ..output import new_figure, save_figure, shown, write_csv, write_summary, writes_folder
 from ..scene import default_scene, load_scene
 from .baselines import baseline_label, simulate_baselines
+from .outcome import OptimizationResult
 from .bound import jerk_lower_bound
 from .heat import heat_check
 from .problem import EngagementOCP
@@ -20,6 +21,7 @@ KEYS = ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral", "dissipat
         "peak_torque_Nm")
 
 
+@writes_folder
 def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, intervals=100, degree=3,
                  sweep_t_max=None, progress=True, max_temperature_C=None, max_specific_power_W_mm2=None):
     """Optimal engagement pressure of a scene: solve, verify with IDAS, compare, write files.
@@ -56,11 +58,39 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         Infeasible limits, bad weights, a scene the optimisation does not cover, IPOPT failure.
     """
     say = print if progress else (lambda *a, **k: None)
+    result = optimize_scene(scene, t_max=t_max, weights=weights, intervals=intervals, degree=degree,
+                            sweep_t_max=sweep_t_max, progress=progress, max_temperature_C=max_temperature_C,
+                            max_specific_power_W_mm2=max_specific_power_W_mm2)
+    summary, scene, ocp, opt, replay = result.summary, result.scene, result.ocp, result.optimum, result.replay
+    out = Path(out_dir)
+    files = [_write_profile(out, ocp, opt), write_summary(out / "summary.json", summary)]
+    files += plot_optimum(out, scene, opt, replay, ocp.baseline, result.baselines, summary)
+    files.append(plot_heat(replay, out / "heat.png"))
+    if "sweep" in summary:
+        files.append(plot_pareto(out, scene, summary["sweep"], summary["initial_slip_rad_s"],
+                                 summary["initial_slip_rate_rad_s2"], ocp))
+    summary["files"] = [shown(f) for f in files]
+    say(format_summary(summary))
+    return summary
+
+
+def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degree=3, sweep_t_max=None,
+                   progress=False, max_temperature_C=None, max_specific_power_W_mm2=None):
+    """Solve, verify with IDAS and compare with the baselines, without writing files.
+
+    Parameters are those of :func:`run_optimize` (``scene`` may also be a name or a path).
+
+    Returns
+    -------
+    clutchocp.optimal.outcome.OptimizationResult
+        ``summary`` (as written to summary.json), the problem, the optimum, its IDAS replay and
+        the baseline runs; ``table()`` and ``plot()`` for a look.
+    """
+    say = print if progress else (lambda *a, **k: None)
     if scene is None:
         scene = default_scene()
     elif isinstance(scene, (str, Path)):
         scene = load_scene(scene)
-    out = Path(out_dir)
     start = time.perf_counter()
     say(f"optimize {scene.name}: building the collocation problem ({intervals} intervals, degree {degree})")
     ocp = EngagementOCP(scene, intervals=intervals, degree=degree, max_temperature_C=max_temperature_C,
@@ -86,7 +116,10 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         "verification": {k: check[k] for k in ("lock_time_rel_diff", "lock_time_resolution_s", "torque_jump_Nm",
                                               "torque_jump_rel", "passed", "holding_pressure_Pa", "collocation",
                                               "idas")},
-        "jerk_lower_bound": bound,
+        # the bound on the same basis as optimal.jerk_integral (output jerk; the slip jerk's bound
+        # times the output's share squared), and the slip-jerk bound the ratio is taken against
+        "jerk_lower_bound": bound * ocp.output_jerk_share**2,
+        "slip_jerk_lower_bound": bound,
         "jerk_lower_bound_ratio": opt.terms["slip_jerk_integral"] / bound,
         "initial_slip_rad_s": w_rel0,
         "initial_slip_rate_rad_s2": rate0,
@@ -105,15 +138,7 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     summary["heat"] = heat_check(ocp, opt, replay)
     if sweep is not None:
         summary["sweep"] = sweep
-    out.mkdir(parents=True, exist_ok=True)
-    files = [_write_profile(out, ocp, opt), write_summary(out / "summary.json", summary)]
-    files += plot_optimum(out, scene, opt, replay, ocp.baseline, baselines, summary)
-    files.append(plot_heat(replay, out / "heat.png"))
-    if sweep is not None:
-        files.append(plot_pareto(out, scene, sweep, w_rel0, rate0, ocp))
-    summary["files"] = [str(f) for f in files]
-    say(format_summary(summary))
-    return summary
+    return OptimizationResult(scene, summary, ocp, opt, replay, baselines)
 
 
 def _fmt(value, unit, fmt="{:.4g}"):
@@ -153,12 +178,16 @@ def _write_profile(out, ocp, opt):
     from each time on. After lock-up (the last time) the command is the holding pressure of the
     verification (summary: verification.holding_pressure_Pa; the last row of a constant command).
     """
+    return write_csv(out / "pressure_profile.csv", profile_columns(ocp, opt))
+
+
+def profile_columns(ocp, opt):
+    """The columns of pressure_profile.csv (see :func:`_write_profile`): {name with unit: array}."""
     times = np.append(opt.command_times, opt.t_f * (1 + HOLD_DELAY)) if opt.control == "constant" \
         else opt.command_times.copy()
     command = np.append(opt.command, holding_pressure(ocp, opt)) if opt.control == "constant" else opt.command
     pressure = np.interp(times, opt.t, opt.outputs["pressure_Pa"])
-    return write_csv(out / "pressure_profile.csv",
-                     {"time_s": times, "pressure_command_Pa": command, "pressure_Pa": pressure})
+    return {"time_s": times, "pressure_command_Pa": command, "pressure_Pa": pressure}
 
 
 def _slip(run):
@@ -172,20 +201,7 @@ def plot_optimum(out, scene, opt, replay, baseline, baselines, summary):
     files = []
     name = scene.name
     runs = (("optimal (IDAS replay)", replay, "C0"), (f"baseline ({summary['baseline']['profile']})", baseline, "C3"))
-
-    fig, (ax,) = new_figure()
-    if opt.control == "constant":
-        ax.step(np.append(opt.command_times, opt.t_f), np.append(opt.command, opt.command[-1]) / 1e6,
-                where="post", color="C0", lw=0.8, alpha=0.6, label="optimal command")
-    else:
-        ax.plot(opt.command_times, opt.command / 1e6, color="C0", lw=0.8, alpha=0.6, label="optimal command")
-    for label, run, color in runs:
-        ax.plot(run.result.t, run.result["pressure_Pa"] / 1e6, color=color, label=label)
-    ax.plot(opt.t, opt.outputs["pressure_Pa"] / 1e6, ".", color="C0", ms=2, label="collocation")
-    ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{name}: engagement pressure")
-    _locks(ax, runs)
-    ax.legend(fontsize=8)
-    files.append(save_figure(fig, out / "pressure.png"))
+    files.append(save_figure(pressure_figure(scene, opt, replay, baseline, summary), out / "pressure.png"))
 
     for key, ylabel, fname, title in (("total_torque_Nm", "clutch torque [N m]", "torque.png", "clutch torque"),
                                       ("output_jerk_rad_s3", "output jerk [rad/s^3]", "jerk.png", "output jerk")):
@@ -209,30 +225,80 @@ def plot_optimum(out, scene, opt, replay, baseline, baselines, summary):
     ax.legend(fontsize=7)
     files.append(save_figure(fig, out / "speeds.png"))
 
-    fig, (ax1, ax2) = new_figure(2, width=4.8)
-    labels = ["optimal"] + list(baselines)
-    jumps = [abs(summary["verification"]["torque_jump_Nm"] or 0.0)] + \
-        [abs(n["lockup_torque_jump_Nm"] or 0.0) for _, n in baselines.values()]
-    jerks = [summary["optimal"]["jerk_integral"]] + [n["jerk_integral"] or 0.0 for _, n in baselines.values()]
-    colors = ["C0"] + ["C3"] * len(baselines)
-    ax1.bar(labels, jumps, color=colors)
-    ax1.set(ylabel="|lock-up torque jump| [N m]", title="torque jump at lock-up")
-    ax2.bar(labels, jerks, color=colors)
-    ax2.set(ylabel="int jerk^2 dt [rad^2/s^5]", title="jerk integral (slip phase)")
-    for ax in (ax1, ax2):
-        ax.tick_params(axis="x", labelrotation=60, labelsize=7)
-    files.append(save_figure(fig, out / "baselines.png"))
+    w_rel0, rate0 = summary["initial_slip_rad_s"], summary["initial_slip_rate_rad_s2"]
+    share = summary["jerk_lower_bound"] / summary["slip_jerk_lower_bound"] if summary["slip_jerk_lower_bound"] else 0.0
+    files.append(plot_baselines(out, name, summary, baselines, lambda T: jerk_lower_bound(w_rel0, rate0, T) * share))
     return files
 
 
+def pressure_figure(scene, opt, replay, baseline, summary):
+    """The optimal command, its IDAS replay, the collocation points and the baseline's pressure."""
+    runs = (("optimal (IDAS replay)", replay, "C0"), (f"baseline ({summary['baseline']['profile']})", baseline, "C3"))
+    fig, (ax,) = new_figure()
+    if opt.control == "constant":
+        ax.step(np.append(opt.command_times, opt.t_f), np.append(opt.command, opt.command[-1]) / 1e6,
+                where="post", color="C0", lw=0.8, alpha=0.6, label="optimal command")
+    else:
+        ax.plot(opt.command_times, opt.command / 1e6, color="C0", lw=0.8, alpha=0.6, label="optimal command")
+    for label, run, color in runs:
+        ax.plot(run.result.t, run.result["pressure_Pa"] / 1e6, color=color, label=label)
+    ax.plot(opt.t, opt.outputs["pressure_Pa"] / 1e6, ".", color="C0", ms=2, label="collocation")
+    ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{scene.name}: engagement pressure")
+    _locks(ax, runs)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def plot_baselines(out, name, summary, baselines, bound_at):
+    """baselines.png: lock-up jumps, and jerk integrals against engagement time with the kinematic bound.
+
+    ``bound_at(T)``: the kinematic lower bound of the output jerk integral for engagement time T [s].
+
+    The jerk integral falls steeply with the engagement time (the bound ~ 1/T^3), so a slower
+    profile can have less jerk than the optimum for a shorter time limit; the right panel therefore
+    draws each profile at its own engagement time, beside the lower bound for every time.
+    """
+    fig, (ax1, ax2) = new_figure(2, width=5.2)
+    labels = ["optimal"] + list(baselines)
+    numbers = [dict(summary["optimal"], lockup_torque_jump_Nm=summary["verification"]["torque_jump_Nm"])] + \
+        [n for _, n in baselines.values()]
+    times = [n["engagement_time_s"] for n in numbers]
+    jumps = [abs(n["lockup_torque_jump_Nm"] or 0.0) for n in numbers]
+    colors = ["C0"] + ["C3"] * len(baselines)
+    bars = ax1.bar(labels, jumps, color=colors)
+    for bar, t_lock in zip(bars, times):
+        ax1.annotate("never" if t_lock is None else f"{t_lock:.3g} s", (bar.get_x() + bar.get_width() / 2,
+                     bar.get_height()), ha="center", va="bottom", fontsize=6)
+    ax1.set(ylabel="|lock-up torque jump| [N m]", title="torque jump at lock-up (label: lock-up time)")
+    ax1.tick_params(axis="x", labelrotation=60, labelsize=7)
+    ok = [(t, n["jerk_integral"], lab) for t, n, lab in zip(times, numbers, labels)
+          if t is not None and n["jerk_integral"] is not None]
+    for t_lock, jerk, label in ok:
+        is_opt = label == "optimal"
+        ax2.plot(t_lock, jerk, "*" if is_opt else "o", color="C0" if is_opt else "C3", ms=12 if is_opt else 6)
+        ax2.annotate(label, (t_lock, jerk), textcoords="offset points", xytext=(4, 3), fontsize=7)
+    if ok:
+        grid = np.linspace(0.8 * min(t for t, _, _ in ok), 1.2 * max(t for t, _, _ in ok), 200)
+        bound = [bound_at(T) for T in grid]
+        if max(bound) > 0:
+            ax2.plot(grid, bound, "k--", lw=0.8, label="kinematic lower bound (same engagement time)")
+        ax2.plot([], [], "*", color="C0", ms=10, label="optimal")
+        ax2.plot([], [], "o", color="C3", label="baseline profiles")
+        ax2.legend(fontsize=7)
+    ax2.set(xlabel="engagement (lock-up) time [s]", ylabel="int jerk^2 dt, slip phase [rad^2/s^5]", yscale="log",
+            title=f"{name}: jerk against engagement time")
+    ax2.grid(alpha=0.3, which="both")
+    return save_figure(fig, out / "baselines.png")
+
+
 def _locks(ax, runs):
-    """Mark the lock-up times and show the time axis up to 1.5 x the later one."""
+    """Mark the lock-up times (in the legend) and show the time axis up to 1.5 x the later one."""
     t_end = max([run.summary["engagement_time_s"] or run.result.t[-1] for _, run, _ in runs])
     ax.set_xlim(0.0, 1.5 * t_end)
-    for _, run, color in runs:
+    for label, run, color in runs:
         t_lock = run.summary["engagement_time_s"]
         if t_lock is not None:
-            ax.axvline(t_lock, color=color, lw=0.8, ls=":")
+            ax.axvline(t_lock, color=color, lw=0.8, ls=":", label=f"lock-up, {label.split(' (')[0]}: {t_lock:.4g} s")
 
 
 def plot_pareto(out, scene, sweep, w_rel0, rate0, ocp):

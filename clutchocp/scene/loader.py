@@ -96,13 +96,29 @@ def _check_value(name, value, spec, unit_hint):
         raise PhysicalRangeError(f"{name} = {value:g}{unit_hint}: must be {phrase}")
 
 
-def parse_field(name, raw, spec):
-    """Convert one raw TOML value to its SI value, or raise a one-line SceneError."""
+def check_value(name, value, spec):
+    """Check an SI value given outside a scene file (an API argument) as the scene field ``spec`` would.
+
+    Raises ParameterTypeError (not a number, or not a whole number for an int field) or
+    PhysicalRangeError (outside the field's range), naming ``name``.
+    """
+    whole = spec.kind == "int"
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or \
+            (whole and not float(value).is_integer()):
+        raise ParameterTypeError(f"{name} = {value!r}: expected {'a whole number' if whole else 'a number'}")
+    _check_value(name, float(value), spec, "" if spec.dim == "1" else f" ({spec.dim})")
+
+
+def parse_field(name, raw, spec, density=None):
+    """Convert one raw TOML value to its SI value, or raise a one-line SceneError.
+
+    ``density`` [kg/m^3] converts a kinematic viscosity (cSt) given for a dynamic one.
+    """
     unit_hint = "" if spec.dim == "1" else f" (SI, {spec.dim})"
     if spec.kind == "quantity":
         if isinstance(raw, (list, dict)):
             raise ParameterTypeError(f"{name}: expected one number or quantity in {spec.dim}, got a {type(raw).__name__}")
-        value = to_si(raw, spec.dim, name)
+        value = to_si(raw, spec.dim, name, density=density)
         _check_value(name, value, spec, unit_hint)
         return value
     if spec.kind == "quantity_list":
@@ -166,10 +182,11 @@ def _validate_part(part_name, table):
                 f"{part_name}.{key}: unknown key in [{where}]{_suggest(key, options)} "
                 f"(allowed: {', '.join(options)})"
             )
-    for key, spec in allowed.items():
+    # the density first: a viscosity given in cSt is converted with it (mu = rho nu)
+    for key, spec in sorted(allowed.items(), key=lambda item: item[0] != "density"):
         name = f"{part_name}.{key}"
         if key in table:
-            values[key] = parse_field(name, table[key], spec)
+            values[key] = parse_field(name, table[key], spec, density=values.get("density"))
         elif spec.required:
             raise MissingParameterError(f"{name}: missing required parameter ({spec.doc})")
         elif spec.default is not None:
@@ -381,7 +398,7 @@ def _split_combined_roughness(scene, overrides):
     if (overrides.get("roughness.sigma") is None or any(k in overrides for k in per_surface)
             or scene.get("roughness.sigma_1") is None or scene.get("roughness.sigma_2") is None):
         return overrides
-    sigma = _parse_field("roughness.sigma", overrides["roughness.sigma"], PARTS["roughness"].fields["sigma"])
+    sigma = parse_field("roughness.sigma", overrides["roughness.sigma"], PARTS["roughness"].fields["sigma"])
     scale = sigma / scene.value("roughness.sigma") if scene.value("roughness.sigma") > 0 else None
     if scale is None:
         raise SceneError("roughness.sigma: this scene gives sigma_1 = sigma_2 = 0; set roughness.sigma_1 and "
@@ -410,7 +427,7 @@ def validate(raw, base_dir):
 def parse_override(text):
     """Parse ``"part.key=value"`` from the command line; the value is read as TOML if it can be."""
     name, eq, value = text.partition("=")
-    if not eq:
+    if not eq or not name.strip():
         raise UnknownKeyError(f"--set {text}: write part.key=value (e.g. oil.viscosity='0.04 Pa s')")
     try:
         parsed = tomllib.loads(f"v = {value.strip()}")["v"]

@@ -8,6 +8,10 @@ left out: the model then compiles without them (no states, no equations, no cost
 
 from dataclasses import dataclass, field as dc_field
 
+MAX_PRESSURE = 1e8           # Pa
+MAX_OUTPUT_POINTS = 200_000
+MAX_INTERFACES = 64
+
 # Value checks: name -> (predicate on the SI value, phrase for the error message).
 CHECKS = {
     "positive": (lambda v: v > 0, "> 0"),
@@ -20,6 +24,18 @@ CHECKS = {
     "friction": (lambda v: 0 < v < 2, "in (0, 2)"),
     "celsius": (lambda v: v > -273.15, "above absolute zero (> -273.15 degC)"),
     "any": (lambda v: True, "any value"),
+    # Limits that protect the machine and the meaning of a result (see RESOURCE_LIMITS):
+    "pressure": (lambda v: 0 <= v <= MAX_PRESSURE, "in [0, 1e8] Pa (100 MPa is above any clutch or valve pressure)"),
+    "positive_pressure": (lambda v: 0 < v <= MAX_PRESSURE,
+                          "in (0, 1e8] Pa (100 MPa is above any clutch or valve pressure)"),
+    "output_points": (lambda v: 2 <= v <= MAX_OUTPUT_POINTS,
+                      f"from 2 to {MAX_OUTPUT_POINTS} (each point keeps every state and output: "
+                      "200 000 points are about 100 MB of results)"),
+    "interfaces": (lambda v: 1 <= v <= MAX_INTERFACES,
+                   f"from 1 to {MAX_INTERFACES} (one film state each; no wet clutch has more, and the run "
+                   "time grows faster than the count: 64 films took 8 s, 5000 ran for minutes)"),
+    "tolerance": (lambda v: 1e-14 <= v <= 1e-2, "from 1e-14 to 1e-2 (looser tolerances give errors of percents)"),
+    "duration": (lambda v: 1e-3 <= v <= 1e4, "from 1e-3 s to 1e4 s (an engagement lasts milliseconds to seconds)"),
 }
 
 
@@ -105,7 +121,7 @@ PARTS = {
         fields={
             "r_inner": Q("m", doc="inner radius of the friction surface [m]"),
             "r_outer": Q("m", doc="outer radius of the friction surface [m]"),
-            "n_interfaces": Field(kind="int", check="positive",
+            "n_interfaces": Field(kind="int", check="interfaces",
                                   doc="number of lubricated friction interfaces (films)"),
             "land_fraction": QOpt("1", 1.0, "fraction", "non-grooved share of the area (Cui psi)"),
             "lining_thickness": QOpt("m", 0.0, doc="friction-lining thickness d [m] (Zhang)"),
@@ -124,7 +140,7 @@ PARTS = {
             "walther": {
                 "kinematic_viscosity_40C": Q("m^2/s", doc="kinematic viscosity at 40 degC [m^2/s] (datasheet)"),
                 "kinematic_viscosity_100C": Q("m^2/s", doc="kinematic viscosity at 100 degC [m^2/s] (datasheet)"),
-                "temperature_C": QOpt("1", None, "celsius",
+                "temperature_C": QOpt("degC", None, "celsius",
                                       "oil temperature [deg C] of a scene without [thermal] (with it: "
                                       "thermal.oil_temperature_C)"),
             },
@@ -138,7 +154,7 @@ PARTS = {
                                  default="patir_cheng", doc="pressure flow factor phi_r"),
             "centrifugal": Field(kind="bool", required=False, default=False,
                                  doc="include the centrifugal term (Bao Eq. 11)"),
-            "inlet_pressure": QOpt("Pa", 0.0, doc="oil pressure at the inner radius [Pa]"),
+            "inlet_pressure": QOpt("Pa", 0.0, "pressure", doc="oil pressure at the inner radius [Pa]"),
             "load_sharing": Field(kind="choice", choices=("reduced", "additive"), required=False,
                                   default="reduced",
                                   doc="fluid load on the free area (1 - A_c/A_n) W_fluid + p_c A_n (Bao Eq. 12, "
@@ -196,7 +212,7 @@ PARTS = {
                 "mu_kinetic": Q("1", "friction", "COF at high slip"),
                 "v_stribeck": Q("m/s", doc="Stribeck velocity [m/s]"),
             },
-            "chen2021": {"temperature_C": Field(kind="quantity", dim="1", check="positive", required=False,
+            "chen2021": {"temperature_C": Field(kind="quantity", dim="degC", check="positive", required=False,
                                                 doc="surface temperature [deg C] (Chen Eq. 5); with a "
                                                     "[thermal] part the law reads the interface temperature")},
             "cui2019": {},
@@ -240,8 +256,8 @@ PARTS = {
         fields={
             "speed_input": QOpt("rad/s", 0.0, doc="input (friction plate) speed [rad/s]"),
             "speed_output": QOpt("rad/s", 0.0, doc="output (separator) speed [rad/s]"),
-            "temperature_C": QOpt("1", None, "positive", "oil / surface temperature [deg C]"),
-            "pressures": Field(kind="quantity_list", dim="Pa", check="nonnegative", required=False,
+            "temperature_C": QOpt("degC", None, "positive", "oil / surface temperature [deg C]"),
+            "pressures": Field(kind="quantity_list", dim="Pa", check="pressure", required=False,
                                doc="applied pressures [Pa]"),
         },
     ),
@@ -277,12 +293,12 @@ PARTS = {
     "actuation": Part(
         "engagement pressure",
         fields={
-            "pressure": Q("Pa", "nonnegative", "set pressure P_o [Pa]"),
-            "initial_pressure": QOpt("Pa", 0.0, doc="pressure at t = 0 [Pa]"),
+            "pressure": Q("Pa", "pressure", "set pressure P_o [Pa]"),
+            "initial_pressure": QOpt("Pa", 0.0, "pressure", doc="pressure at t = 0 [Pa]"),
             "t_start": QOpt("s", 0.0, doc="time the command starts [s]"),
             "area": QOpt("m^2", None, "positive",
                          "area the pressure acts on when there is no piston [m^2] (default: plate area)"),
-            "max_pressure": QOpt("Pa", None, "positive", "upper pressure limit [Pa]"),
+            "max_pressure": QOpt("Pa", None, "positive_pressure", "upper pressure limit [Pa]"),
         },
         variants={
             "step": {},
@@ -330,8 +346,8 @@ PARTS = {
         "lumped plate temperatures (optional): the heat of the slip and squeeze films, stored in the "
         "friction plates and separators and convected to the oil",
         fields={
-            "oil_temperature_C": Q("1", "celsius", "cooling-oil temperature [deg C]"),
-            "initial_temperature_C": QOpt("1", None, "celsius",
+            "oil_temperature_C": Q("degC", "celsius", "cooling-oil temperature [deg C]"),
+            "initial_temperature_C": QOpt("degC", None, "celsius",
                                           "plate temperature at t = 0 [deg C] (default: the oil temperature)"),
             "separator_heat_capacity": Q("J/K", doc="heat capacity of the separator steel heated by the pack's "
                                                     "interfaces, whole pack [J/K]"),
@@ -348,10 +364,10 @@ PARTS = {
     "simulation": Part(
         "integration settings",
         fields={
-            "t_end": Q("s", doc="end time [s]"),
-            "rtol": QOpt("1", 1e-8, "positive", "relative tolerance"),
-            "atol": QOpt("1", 1e-10, "positive", "absolute tolerance (scaled states)"),
-            "output_points": Field(kind="int", check="positive", required=False, default=2001,
+            "t_end": Q("s", "duration", doc="end time [s]"),
+            "rtol": QOpt("1", 1e-8, "tolerance", "relative tolerance"),
+            "atol": QOpt("1", 1e-10, "tolerance", "absolute tolerance (scaled states)"),
+            "output_points": Field(kind="int", check="output_points", required=False, default=2001,
                                    doc="number of output times"),
         },
     ),
@@ -368,8 +384,8 @@ PARTS = {
                                        "free-surface radius r0 of the rotating control oil [m] (Liao Eq. 15); "
                                        "absent: no centrifugal cylinder force"),
             "valve_time_constant": Q("s", doc="time constant of the pressure valve [s] (a state)"),
-            "pressure_min": QOpt("Pa", 0.0, doc="lowest control pressure the valve gives [Pa]"),
-            "pressure_max": Q("Pa", doc="highest control pressure the valve gives [Pa]"),
+            "pressure_min": QOpt("Pa", 0.0, "pressure", doc="lowest control pressure the valve gives [Pa]"),
+            "pressure_max": Q("Pa", "positive_pressure", doc="highest control pressure the valve gives [Pa]"),
             "spline_friction": QOpt("1", None, "friction",
                                     "friction coefficient f of the plates in their splines (Liao Eq. 10); "
                                     "needed with [hvc]"),

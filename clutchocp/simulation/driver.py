@@ -4,6 +4,7 @@ import time
 
 import numpy as np
 
+from clutchocp import interrupt
 from clutchocp.errors import ModelError, SolverError
 from clutchocp.simulation.diagnostics import solver_error
 from clutchocp.simulation.events import ARMED, PASSED, EventMonitor
@@ -247,6 +248,7 @@ class _Run:
     def loop(self):
         t_final = self.grid[-1]
         while self.t < t_final - self.tiny:
+            interrupt.check(f"{self.path.name} at t = {self.t:.6g} s")
             if self.path.deadline is not None and time.perf_counter() > self.path.deadline:
                 raise solver_error(self.path.name, "wall_time", self.t, self.cm, self.xs, self.zs,
                                    detail=f" ({self.opts.max_wall_time:g} s)")

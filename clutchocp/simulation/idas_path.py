@@ -54,6 +54,7 @@ from collections import OrderedDict
 import casadi as ca
 import numpy as np
 
+from clutchocp import interrupt
 from clutchocp.errors import ModelError
 from clutchocp.simulation.diagnostics import idas_flag, solver_error
 from clutchocp.simulation.events import ARMED, ENTRY, Advance, Crossing, locate
@@ -220,8 +221,11 @@ class IdasPath:
             xs, zs = entry(x0, z0, p)
         except RuntimeError as err:
             self._count(entry.stats(), start)
+            # a Ctrl-C inside IDAS surfaces as a failed step ("psetup failed: KeyboardInterrupt")
+            interrupt.check(f"{self.name.upper()} at t = {p[-2]:.6g} s")
             raise _IdasFailure(idas_flag(err), str(err)) from None
         self._count(entry.stats(), start)
+        interrupt.check(f"{self.name.upper()} at t = {p[-2]:.6g} s")
         return xs, zs
 
     def _count(self, stats, start):

@@ -94,3 +94,42 @@ class SimulationResult:
     def event_times(self, name=None):
         """Times of all switches (or of the events called ``name``)."""
         return np.array([e.t for e in self.events if name is None or e.name == name])
+
+
+def _short_repr(self):
+    modes = []
+    for seg in self.segments:
+        if not modes or modes[-1] != str(seg.mode):
+            modes.append(str(seg.mode))
+    span = f"{self.t[0]:.4g} ... {self.t[-1]:.4g} s" if self.t.size else "empty"
+    return (f"SimulationResult({self.t.size} samples, {span}, modes {' -> '.join(modes) or 'none'}, "
+            f"{len(self.events)} events, {len(self.names())} variables)")
+
+
+SimulationResult.__repr__ = _short_repr
+
+
+class Table(dict):
+    """Columns of equal length, each named with its unit (``"time_s"``, ``"pressure_Pa"``, ``"mode"``).
+
+    A dict ``{name: numpy array}`` with a short repr, :attr:`units` and :meth:`to_csv`.
+    """
+
+    UNITS = (("_rad_s3", "rad/s^3"), ("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_m_s", "m/s"),
+             ("_Nm", "N m"), ("_Pa", "Pa"), ("_N", "N"), ("_W", "W"), ("_J", "J"), ("_m", "m"), ("_s", "s"))
+
+    @property
+    def units(self):
+        """{column: unit} read off the name's suffix ("" for text columns such as ``mode``)."""
+        return {name: next((unit for suffix, unit in self.UNITS if name.endswith(suffix)), "") for name in self}
+
+    def to_csv(self, path):
+        """Write the table as CSV (the header holds the names with their units); returns the path."""
+        from clutchocp.output import write_csv
+        return write_csv(path, {k: [str(v) for v in col] if k == "mode" else col for k, col in self.items()})
+
+    def __repr__(self):
+        rows = len(next(iter(self.values()))) if self else 0
+        names = list(self)
+        shown = ", ".join(names[:6]) + (f", ... ({len(names)} columns)" if len(names) > 6 else "")
+        return f"Table({rows} rows: {shown})"

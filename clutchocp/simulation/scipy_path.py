@@ -17,6 +17,7 @@ import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from clutchocp import interrupt
 from clutchocp.simulation.diagnostics import solver_error
 from clutchocp.simulation.events import Advance, Crossing
 
@@ -93,6 +94,7 @@ class ScipyPath:
             return np.array(cm.consistent_z(xs, pu, t, guess["z"]), dtype=float)
 
         def rhs(t, xs):
+            interrupt.check(f"scipy {self.method} at t = {t:.6g} s")
             if self.deadline is not None and time.perf_counter() > self.deadline:
                 raise solver_error(f"scipy {self.method}", "wall_time", t, cm, xs,
                                    detail=f" ({self.options.max_wall_time:g} s)")

@@ -1,0 +1,64 @@
+"""The result of :func:`clutchocp.optimize`: the optimum, its IDAS check and the baselines, at a glance."""
+
+from dataclasses import dataclass, field
+
+from ..simulation.result import Table
+
+
+@dataclass(repr=False)
+class OptimizationResult:
+    """An optimal engagement pressure with everything needed to judge it.
+
+    Attributes
+    ----------
+    scene : clutchocp.scene.Scene
+    summary : dict
+        The numbers written to summary.json by ``clutchocp optimize`` (see the README).
+    ocp : clutchocp.optimal.problem.EngagementOCP
+        The problem (reuse it for further solves).
+    optimum : clutchocp.optimal.problem.OptimalEngagement
+        The collocation solution (command, states, terms, IPOPT statistics).
+    replay : clutchocp.engagement.run.EngagementResult
+        The optimal command re-simulated with IDAS.
+    baselines : dict
+        ``{label: (EngagementResult, numbers)}`` of the step, ramp and lag profiles.
+    """
+
+    scene: object
+    summary: dict
+    ocp: object
+    optimum: object
+    replay: object
+    baselines: dict = field(default_factory=dict)
+
+    def __repr__(self):
+        s = self.summary
+        opt, ver = s["optimal"], s["verification"]
+        return (f"OptimizationResult(scene={self.scene.name!r}, {s['solver']['status']}, lock-up "
+                f"{opt['engagement_time_s']:.4g} s, jump {opt['lockup_torque_jump_Nm']:.3g} N m, "
+                f"jerk integral {opt['jerk_integral']:.4g} rad^2/s^5, IDAS check "
+                f"{'passed' if ver['passed'] else 'FAILED'})")
+
+    @property
+    def success(self):
+        """True if IPOPT converged and the IDAS replay confirmed the lock-up."""
+        return bool(self.optimum.success and self.summary["verification"]["passed"])
+
+    def table(self):
+        """The pressure profile: ``time_s``, ``pressure_command_Pa``, ``pressure_Pa`` (pressure_profile.csv)."""
+        from .report import profile_columns
+        return Table(profile_columns(self.ocp, self.optimum))
+
+    def plot(self, path=None):
+        """The pressure figure (command, IDAS replay, baseline); saved as PNG if ``path`` is given.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from ..output import save_figure
+        from .report import pressure_figure
+        fig = pressure_figure(self.scene, self.optimum, self.replay, self.ocp.baseline, self.summary)
+        if path is not None:
+            save_figure(fig, path)
+        return fig

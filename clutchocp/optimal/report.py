@@ -108,7 +108,8 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     out.mkdir(parents=True, exist_ok=True)
     files = [_write_profile(out, ocp, opt), write_summary(out / "summary.json", summary)]
     files += plot_optimum(out, scene, opt, replay, ocp.baseline, baselines, summary)
-    files.append(plot_heat(replay, out / "heat.png"))
+    files.append(plot_heat(replay, out / "heat.png", max_temperature_C=max_temperature_C,
+                           max_specific_power_W_mm2=max_specific_power_W_mm2, what="the IDAS replay of the optimum"))
     if sweep is not None:
         files.append(plot_pareto(out, scene, sweep, w_rel0, rate0, ocp))
     summary["files"] = [str(f) for f in files]

@@ -105,9 +105,11 @@ def test_scene_without_piston_has_no_piston_states():
 
 def test_energy_accumulators_only_for_the_parts_a_scene_has():
     """zhang2021 has no piston (no seal), no load, no splines and a rigid shaft: six accumulators;
-    bao2020 adds the piston seal; default_driveline has no piston but a load on its output."""
+    bao2020 adds the piston seal; default_driveline has no piston but a load on its output and a
+    [thermal] part (heat convected to the oil)."""
     common = {"E_source", "E_hydraulic", "E_slip", "E_film", "E_contact", "E_impact"}
-    for name, extra in (("zhang2021", set()), ("bao2020", {"E_seal"}), ("default_driveline", {"E_load"})):
+    for name, extra in (("zhang2021", set()), ("bao2020", {"E_seal"}),
+                        ("default_driveline", {"E_load", "E_convection"})):
         model = EngagementModel(load_scene(name))
         assert {n for n in model.state_names if n.startswith("E_")} == common | extra, name
 

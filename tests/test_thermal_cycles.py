@@ -65,9 +65,9 @@ def test_drift_and_temperature_limit(scene):
     assert summary["engagement_time_drift_s"] == pytest.approx(times[1] - times[0])
 
 
-def test_errors(scene):
+def test_errors(scene, default_without_thermal):
     with pytest.raises(ModelError, match="thermal"):
-        run_cycles(load_scene("default_driveline"), cycles=2)
+        run_cycles(default_without_thermal, cycles=2)
     with pytest.raises(ModelError, match="cycles"):
         run_cycles(scene, cycles=0)
     with pytest.raises(ModelError, match="cooling_time"):
@@ -83,7 +83,7 @@ def test_cli_cycles_and_simulate_heat_files(tmp_path, capsys):
     rows = list(csv.DictReader((out / "cycles.csv").open()))
     assert len(rows) == 2 and float(rows[1]["start_interface_temperature_C"]) > 40.0
     assert (out / "cycles.png").stat().st_size > 0
-    assert main(["cycles", "default_driveline", "--out", str(tmp_path / "bad")]) == 2
+    assert main(["cycles", "zhang2021", "--out", str(tmp_path / "bad")]) == 2
     assert "thermal" in capsys.readouterr().err
     sim = tmp_path / "sim"
     assert main(["simulate", "default_driveline_thermal", "--out", str(sim)]) == 0

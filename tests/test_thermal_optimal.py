@@ -43,8 +43,8 @@ def test_specific_power_limit_is_met(free):
     assert float(result.outputs_points["interface_heat_power_W"].max()) / area <= 0.9 * peak * (1 + 1e-6)
 
 
-def test_limit_errors():
-    scene = load_scene("default_driveline")
+def test_limit_errors(default_without_thermal):
+    scene = default_without_thermal
     with pytest.raises(ModelError, match="max_temperature_C: the scene has no"):
         EngagementOCP(scene, intervals=INTERVALS, max_temperature_C=80.0)
     with pytest.raises(ModelError, match="max_specific_power_W_mm2"):

@@ -76,7 +76,7 @@ def test_fit_rejects_bad_points():
 
 
 def walther_scene(**oil):
-    base = load_scene("default_driveline")
+    base = load_scene("zhang2021")
     values = {"oil.viscosity": None, "oil.model": "walther", "oil.kinematic_viscosity_40C": "80.12 cSt",
               "oil.kinematic_viscosity_100C": "9.5 mm^2/s"}
     values.update({f"oil.{k}": v for k, v in oil.items()})

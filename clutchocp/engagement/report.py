@@ -155,24 +155,29 @@ def plot_torque_response(run, path):
     return save_figure(fig, path)
 
 
-def plot_heat(run, path):
+def plot_heat(run, path, *, max_temperature_C=None, max_specific_power_W_mm2=None, what="the engagement"):
     """Specific power of the friction area against time, and the plate temperatures if the scene
-    has a [thermal] part (left panel); returns the PNG path."""
+    has a [thermal] part (left panel), with the limits given drawn as lines; returns the PNG path.
+    ``what`` names the run in the title (e.g. "the IDAS replay of the optimum")."""
     res, model, summary = run.result, run.model, run.summary
     t = res.t
     fig, axes = new_figure(2 if model.thermal.present else 1)
     ax = axes[-1]
     ax.plot(t, res["interface_heat_power_W"] / summary["friction_area_mm2"], color="C3", label="specific power")
+    if max_specific_power_W_mm2 is not None:
+        ax.axhline(max_specific_power_W_mm2, color="k", ls="--", lw=0.8, label="limit")
     ax.set(xlabel="time [s]", ylabel="specific power [W/mm^2]",
            title=f"specific energy {summary['specific_energy_J_mm2']:.3g} J/mm^2 "
                  f"over {summary['friction_area_mm2']:.0f} mm^2 of friction area")
-    fig.suptitle(f"{summary['scene']}: heat of the engagement at the friction interfaces")
+    fig.suptitle(f"{summary['scene']}: heat of {what} at the friction interfaces")
     if model.thermal.present:
         hot = axes[0]
         hot.plot(t, res["interface_temperature_C"], "k", lw=1.5, label="interface (contact)")
         hot.plot(t, res["T_separator"], "C0", label="separators (bulk)")
         hot.plot(t, res["T_friction"], "C1", label="friction plates (bulk)")
         hot.axhline(model.thermal.T_oil, color="C2", ls=":", label="oil")
+        if max_temperature_C is not None:
+            hot.axhline(max_temperature_C, color="k", ls="--", lw=0.8, label="interface limit")
         hot.set(xlabel="time [s]", ylabel="temperature [degC]",
                 title=f"peak interface temperature {summary['peak_interface_temperature_C']:.1f} degC (lumped)")
         if summary["engagement_time_s"] is not None:

@@ -22,7 +22,8 @@ its event tolerance) and leaves a jump of -0.5 % of the locked torque.
 
 Constraints: t_f <= t_max, E <= E_max, films h >= h_min, 0 <= u <= actuation.max_pressure,
 |du/dt| <= rate limit, w_rel >= 0; optionally interface temperature <= max_temperature_C (a scene
-with [thermal]) and interface heat per friction area <= max_specific_power_W_mm2 (path constraints). The ``smooth`` term regularises the command: without it the
+with [thermal]) and interface heat per friction area <= max_specific_power_W_mm2 (path constraints,
+:mod:`clutchocp.optimal.heat`). The ``smooth`` term regularises the command: without it the
 command reaches the objective only through two integrations (valve lag, film) and IPOPT meets a
 nearly singular Hessian and a bang-bang command (measured on the default scene: weight 1e-4 gave a
 rate-limited bang-bang command; 0.1, the default, a smooth one for 8 % more jerk integral). The

@@ -65,7 +65,8 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     out = Path(out_dir)
     files = [_write_profile(out, ocp, opt), write_summary(out / "summary.json", summary)]
     files += plot_optimum(out, scene, opt, replay, ocp.baseline, result.baselines, summary)
-    files.append(plot_heat(replay, out / "heat.png"))
+    files.append(plot_heat(replay, out / "heat.png", max_temperature_C=max_temperature_C,
+                           max_specific_power_W_mm2=max_specific_power_W_mm2, what="the IDAS replay of the optimum"))
     if "sweep" in summary:
         files.append(plot_pareto(out, scene, summary["sweep"], summary["initial_slip_rad_s"],
                                  summary["initial_slip_rate_rad_s2"], ocp))

@@ -15,7 +15,8 @@ Lumped means the bulk temperatures: the flash temperature at the asperities and 
 across a thick lining are not resolved, so the interface temperature is a lower bound of the
 true surface temperature (see the assumptions of the scenes that use it).
 
-Every function takes floats, numpy arrays or CasADi symbols; temperatures in degC, SI otherwise.
+``interface_temperature`` and ``plate_heating_rates`` take floats, numpy arrays or CasADi symbols
+(they are the model's equations); the others take numbers. Temperatures in degC, SI otherwise.
 """
 
 import math

@@ -21,6 +21,7 @@ from ..errors import (
     UnknownKeyError,
     UnknownVariantError,
 )
+from ..physics.friction import CHEN_THETA_MIN
 from ..physics.viscosity import walther_coefficients, walther_kinematic_viscosity
 from ..units import to_si
 from .schema import CHECKS, PARTS, REQUIRED_PARTS
@@ -279,6 +280,10 @@ def _check_temperatures(values):
         thermal.setdefault("initial_temperature_C", thermal["oil_temperature_C"])
     if friction.get("model") == "chen2021":
         _fixed_temperature("friction", friction, thermal is not None, "Chen's law reads the interface temperature")
+        for key in ("oil_temperature_C", "initial_temperature_C") if thermal is not None else ():
+            if not thermal[key] > CHEN_THETA_MIN:       # the plates never cool below the oil or their start
+                raise PhysicalRangeError(f"thermal.{key} = {thermal[key]:g}: must be > {CHEN_THETA_MIN:.4g} degC "
+                                         "with friction.model = 'chen2021' (Chen 2021 Eq. 5 fit domain)")
     if oil.get("model") != "walther":
         return
     _fixed_temperature("oil", oil, thermal is not None, "the oil temperature is thermal.oil_temperature_C")

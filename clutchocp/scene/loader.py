@@ -145,7 +145,7 @@ def _validate_part(part_name, table):
     variant = ""
     if part.variants:
         variant = table.get("model", part.default_variant)
-        if variant not in part.variants:
+        if not isinstance(variant, str) or variant not in part.variants:
             raise UnknownVariantError(
                 f"{part_name}.model = {variant!r}: unknown variant; allowed: {', '.join(part.variants)}"
                 + (_suggest(variant, part.variants) if isinstance(variant, str) else "")

@@ -102,10 +102,14 @@ def test_t_max_the_end_conditions_cannot_meet_is_a_clean_solver_error(scene, ocp
 
 
 def test_energy_limit_is_respected(ocp, opt):
+    """The limit holds and costs objective. The objective is the jerk integral plus the command's
+    smoothness term (weight 0.1), so the jerk integral alone may fall: on default_driveline with the
+    lining rough (separator smooth) it does, 4.549e5 -> 4.496e5, while the objective rises
+    1.61584 -> 1.61859."""
     e_max = 0.99 * opt.terms["dissipated_energy_J"]
     limited = ocp.solve(e_max=e_max, guess=opt)
     assert limited.terms["dissipated_energy_J"] <= e_max * (1 + 1e-6)
-    assert limited.terms["jerk_integral"] > opt.terms["jerk_integral"]     # the limit costs comfort
+    assert limited.objective > opt.objective                                # the limit costs objective
 
 
 def test_collocation_error_falls_as_intervals_grow(scene, ocp, opt):

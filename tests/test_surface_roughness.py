@@ -67,6 +67,9 @@ def test_combined_roughness_override_keeps_the_split():
     doubled = mixed.with_overrides({"roughness.sigma": "10 um"})
     assert doubled.value("roughness.sigma_1") == pytest.approx(6e-6) and doubled.value("roughness.sigma_2") == pytest.approx(8e-6)
     assert doubled.value("roughness.sigma") == pytest.approx(10e-6)
+    # both surfaces on a scene that gives the combined sigma replace it
+    split = load_scene("bao2020").with_overrides({"roughness.sigma_1": "6 um", "roughness.sigma_2": "8 um"})
+    assert split.value("roughness.sigma") == pytest.approx(10e-6) and split.value("roughness.sigma_2") == 8e-6
 
 
 def test_a_rough_lining_on_a_smooth_separator_lowers_the_viscous_peak():

@@ -166,7 +166,7 @@ def _validate_part(part_name, table):
     variant = ""
     if part.variants:
         variant = table.get("model", part.default_variant)
-        if variant not in part.variants:
+        if not isinstance(variant, str) or variant not in part.variants:
             raise UnknownVariantError(
                 f"{part_name}.model = {variant!r}: unknown variant; allowed: {', '.join(part.variants)}"
                 + (_suggest(variant, part.variants) if isinstance(variant, str) else "")
@@ -368,9 +368,10 @@ class Scene:
         """A new scene with ``{"part.key": value}`` replaced (values as in a scene file; None removes the key).
 
         ``roughness.sigma`` (the combined RMS) on a scene that gives the roughness per surface scales
-        ``sigma_1`` and ``sigma_2`` to the new combined value, keeping their ratio.
+        ``sigma_1`` and ``sigma_2`` to the new combined value, keeping their ratio; ``sigma_1`` and
+        ``sigma_2`` together on a scene that gives ``sigma`` replace it.
         """
-        overrides = _split_combined_roughness(self, overrides)
+        overrides = _roughness_overrides(self, overrides)
         raw = {part: dict(table) if isinstance(table, dict) else table for part, table in self.raw.items()}
         for name, value in overrides.items():
             part, dot, key = name.partition(".")
@@ -409,10 +410,14 @@ class Scene:
         return f"Scene({self.name!r}, kind={self.kind!r}, parts={list(self.parts)})"
 
 
-def _split_combined_roughness(scene, overrides):
-    """Overrides with a combined ``roughness.sigma`` turned into ``sigma_1``/``sigma_2`` of the same ratio,
-    where the scene gives the roughness per surface (and the overrides do not set them)."""
+def _roughness_overrides(scene, overrides):
+    """Overrides with the roughness given the way the scene gives it: a combined ``roughness.sigma`` turned
+    into ``sigma_1``/``sigma_2`` of the same ratio where the scene gives the surfaces, and the scene's
+    ``sigma`` removed where the overrides give both surfaces."""
     per_surface = ("roughness.sigma_1", "roughness.sigma_2")
+    if (all(overrides.get(k) is not None for k in per_surface) and "roughness.sigma" not in overrides
+            and scene.get("roughness.sigma_1") is None):
+        return {**overrides, "roughness.sigma": None}
     if (overrides.get("roughness.sigma") is None or any(k in overrides for k in per_surface)
             or scene.get("roughness.sigma_1") is None or scene.get("roughness.sigma_2") is None):
         return overrides

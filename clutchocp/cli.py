@@ -93,8 +93,14 @@ def _parse_sweep(text):
 
 def _cmd_optimize(args):
     from .optimal.report import run_optimize
+    from .scene import default_scene, load_scene, parse_override
 
-    run_optimize(args.scene, out_dir=args.out, t_max=args.t_max,
+    overrides = dict(parse_override(text) for text in args.set)
+    if args.scene is None:
+        scene = default_scene().with_overrides(overrides) if overrides else default_scene()
+    else:
+        scene = load_scene(args.scene, overrides=overrides)
+    run_optimize(scene, out_dir=args.out, t_max=args.t_max,
                  weights=_parse_weights(args.weights) if args.weights else None,
                  intervals=args.intervals, degree=args.degree,
                  sweep_t_max=_parse_sweep(args.sweep_t_max) if args.sweep_t_max else None)
@@ -137,9 +143,11 @@ def build_parser():
     p = sub.add_parser("optimize", help="optimal engagement pressure by direct collocation (the main job)")
     p.add_argument("scene", nargs="?", default=None, help="engagement scene (default: the default scene)")
     p.add_argument("--out", default="out/optimize", help="output folder (default: out/optimize)")
+    p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
+                   help="override a scene value, e.g. --set actuation.max_pressure='1.2 MPa' (repeatable)")
     p.add_argument("--t-max", type=float, default=None, help="largest engagement time [s]")
     p.add_argument("--weights", default=None, metavar="NAME=W,...",
-                   help="objective weights, e.g. jerk=1,energy=0.1,time=0,jump=1")
+                   help="objective weights, e.g. jerk=1,energy=0.1,time=0,jump=1,fill_time=0,kiss_speed=0")
     p.add_argument("--intervals", type=int, default=100, help="collocation intervals (default: 100)")
     p.add_argument("--degree", type=int, default=3, help="collocation points per interval (default: 3)")
     p.add_argument("--sweep-t-max", default=None, metavar="LIST|START:STOP:COUNT",

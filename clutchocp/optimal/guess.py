@@ -34,11 +34,13 @@ def mode_samples(run, mode, t_start, t_end):
     return t, np.nonzero(mask)[0][order]
 
 
-def slip_samples(run):
-    """Samples of a run in forward slip up to lock-up: (times, their indices in the run, lock-up time)."""
-    window = phase_windows(run)[SLIP_MODE]
-    t, idx = mode_samples(run, SLIP_MODE, *window)
-    return t, idx, window[1]
+def engagement_samples(run):
+    """Samples of a run from t = 0 up to lock-up, fill and slip (times, their indices in the run)."""
+    t_lock = phase_windows(run)[SLIP_MODE][1]
+    res = run.result
+    mask = np.isin(np.asarray(res.mode), ("approach_slip_forward", SLIP_MODE)) & (res.t <= t_lock)
+    t, order = np.unique(res.t[mask], return_index=True)
+    return t, np.nonzero(mask)[0][order]
 
 
 def command_history(run, t):

@@ -555,7 +555,8 @@ class EngagementOCP:
         """One IPOPT solve of this problem (no polish)."""
         from .guess import guess_from_optimum, guess_from_run
         nlp, sc = self.phased, self.scales
-        warm = isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size
+        warm = isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size \
+            and guess.lam_g.size == nlp.lbg.size
         if warm:
             w0, lam_x0, lam_g0 = guess.w.copy(), guess.lam_x, guess.lam_g
         else:

@@ -94,7 +94,7 @@ def fill_pulse_command(pulse_time, hold_pressure, hold_time, ramp_rate, *, p_max
     return times[keep], values[keep]
 
 
-def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=JUMP_TOLERANCE, max_evaluations=80,
+def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=JUMP_TOLERANCE, max_evaluations=60,
                     progress=None):
     """The "fill pulse, hold, ramp" command that locks up soonest with peak jerk <= ``jerk_cap`` and
     a lock-up jump within ``jump_limit`` of the locked torque (the conditions the optimum meets).
@@ -157,7 +157,7 @@ def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=J
                 progress(f"  fill-pulse baseline search: {len(cache)} runs, best cost {best[0]:.4g}")
         return cache[key][0]
 
-    z0 = np.array([0.1, 0.3, 0.1, 0.5])
+    z0 = np.array([0.1, 0.3, 0.1, 0.2])
     minimize(evaluate, z0, method="Nelder-Mead",
              options={"maxfev": max_evaluations, "initial_simplex": _simplex(z0), "xatol": 1e-3, "fatol": 1e-4})
     key, (cost, times, values, run, numbers) = min(cache.items(), key=lambda item: item[1][0])

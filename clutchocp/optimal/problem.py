@@ -242,7 +242,10 @@ class EngagementOCP:
         self.nominal = self.model.nominal[self._phys]
         self.x0 = self.model.initial_state[self._phys]
         self.scales = self._scales()
-        self.phase_functions = {name: self._build_functions(mode, name) for name, mode in self.phase_modes}
+        self.phase_functions = {"slip": self._build_functions(SLIP_MODE, "slip")}
+        if self.phase_modes[0][0] == "fill":
+            self.kiss_jerk_fn = self._kiss_jerk_fn()
+            self.phase_functions["fill"] = self._build_functions(FILL_MODE, "fill")
         for key, fn in self.phase_functions["slip"].items():     # the slip phase's blocks, as before
             setattr(self, key, fn)
         self.phased = self._phased_nlp()
@@ -387,7 +390,10 @@ class EngagementOCP:
                  + w["kiss_speed"] * kiss**2)
             out["objective_fn"] = ca.Function("objective", [xs, us, Q, T, weights], [J])
             i_x0 = self._names.index("x0")
-            out["end_fn"] = ca.Function("end", [xs, us, T, weights], [xs[i_x0] - self.model.travel / self.nominal[i_x0]])
+            g_end = [xs[i_x0] - self.model.travel / self.nominal[i_x0]]
+            if self.jerk_max is not None:     # the jerk just after the kiss (slip mode, after the reset)
+                g_end.append(self.kiss_jerk_fn(xs, us) / self.jerk_max)
+            out["end_fn"] = ca.Function("end", [xs, us, T, weights], [ca.vertcat(*g_end)])
             out["jump_fn"] = ca.Function("jump", [xs, us], [jump * sc.torque_Nm])
             return out
         if self.holds_torque:
@@ -424,6 +430,8 @@ class EngagementOCP:
                 x_lb[i] = (self.h_min or 0.0) / self.nominal[i]
         if role == "fill":
             end_lb, end_ub = np.zeros(1), np.zeros(1)
+            if self.jerk_max is not None:
+                end_lb, end_ub = np.array([0.0, -1.0]), np.array([0.0, 1.0])
         else:
             n_end = 2 + (self.jump_mode == "constraint") + self.holds_torque
             end_lb, end_ub = np.zeros(n_end), np.zeros(n_end)
@@ -472,6 +480,14 @@ class EngagementOCP:
         loss = subs(reset["E_impact"] - self.model.state("E_impact")) if "E_impact" in reset else 0.0
         after.append(xs[n] + loss / self.scales.energy_J)
         return ca.Function("impact_reset", [xs], [ca.vertcat(*after)])
+
+    def _kiss_jerk_fn(self):
+        """The felt jerk just after the kiss [rad/s^3]: the slip mode's, at the impact-reset state."""
+        n = len(self._phys)
+        xs, us = ca.SX.sym("xs", n + 1), ca.SX.sym("us")
+        slip = self.phase_functions["slip"]
+        index = slip["output_names"].index("slip_jerk_rad_s3" if self.output_held else "output_jerk_rad_s3")
+        return ca.Function("kiss_jerk", [xs, us], [slip["outputs_fn"](self.impact_reset()(xs), us)[index]])
 
     def impact_link(self):
         """Link residual of the fill -> slip junction: ``(x_end, x_start) -> x_start - reset(x_end)``."""
@@ -652,6 +668,9 @@ class EngagementOCP:
             fill = pieces[0]
             terms["fill_time_s"] = fill["T"]
             terms["kiss_speed_m_s"] = float(fill["outputs"]["piston_speed_m_s"][-1])
+            # the jerk just after the kiss (at the slip phase's first node, which no collocation point sees)
+            terms["kiss_jerk_rad_s3"] = float(last["outputs"][felt][0]) if len(pieces) == 2 else None
+            terms["peak_jerk_rad_s3"] = max(terms["peak_jerk_rad_s3"], abs(terms["kiss_jerk_rad_s3"]))
         return OptimalEngagement(T, t, t_points, command_times, command, tr.transcription.control, states, outputs,
                                  outputs_points, terms, objective, stats, w, lam_x, lam_g, weights, phases=phases)
 

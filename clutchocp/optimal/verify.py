@@ -30,14 +30,15 @@ def run_numbers(run):
         engagement_time_s, lockup_torque_jump_Nm, jerk_integral (int jerk^2 dt from t = 0 to
         lock-up, fill and slip [rad^2/s^5], trapezoidal on the output samples), peak_jerk_rad_s3, peak_torque_Nm,
         dissipated_energy_J (at lock-up), locked_torque_Nm, kiss_time_s and kiss_speed_m_s (the
-        impact of the piston on the pack; None without free travel). With the output held (a brake)
+        impact of the piston on the pack; None without free travel), kiss_jerk_rad_s3 (the jerk just
+        after the kiss, part of the peak jerk). With the output held (a brake)
         the jerk is the input's, -dT/dt / I_in by differences of the clutch torque.
     """
     summary = run.summary
     out = {"engagement_time_s": summary["engagement_time_s"], "lockup_torque_jump_Nm": summary["lockup_torque_jump_Nm"],
            "jerk_integral": None, "peak_jerk_rad_s3": None, "peak_torque_Nm": summary["peak_torque_Nm"],
            "dissipated_energy_J": summary["dissipated_energy_J"], "locked_torque_Nm": None,
-           "kiss_time_s": None, "kiss_speed_m_s": None}
+           "kiss_time_s": None, "kiss_speed_m_s": None, "kiss_jerk_rad_s3": None}
     impact = [e for e in run.result.events if e.name == "impact"]
     if impact:
         out["kiss_time_s"], out["kiss_speed_m_s"] = float(impact[0].t), float(impact[0].x_before["v0"])
@@ -51,6 +52,12 @@ def run_numbers(run):
         jerk = run.result["output_jerk_rad_s3"][idx]
     out["jerk_integral"] = float(np.trapezoid(jerk**2, t))
     out["peak_jerk_rad_s3"] = float(np.max(np.abs(jerk)))
+    if impact and not output_held(model):
+        # the jerk just after the kiss: the sample of the pressing mode at the impact time
+        after = np.flatnonzero((run.result.t == impact[0].t) & (np.asarray(run.result.mode) == "pressing_slip_forward"))
+        out["kiss_jerk_rad_s3"] = float(run.result["output_jerk_rad_s3"][after[0]]) if after.size else None
+        if after.size:
+            out["peak_jerk_rad_s3"] = max(out["peak_jerk_rad_s3"], abs(out["kiss_jerk_rad_s3"]))
     out["peak_torque_Nm"] = float(np.max(np.abs(run.result["total_torque_Nm"][idx])))
     lock = next(e for e in run.result.events if e.name == "lockup" and e.target.endswith("locked"))
     out["dissipated_energy_J"] = float(sum(lock.x_before[name] for name in DISSIPATED if name in lock.x_before))
@@ -106,6 +113,7 @@ def verify(ocp, opt, *, model=None, rtol=None, atol=None):
                                         "peak_jerk_rad_s3", "peak_torque_Nm", "dissipated_energy_J",
                                         "locked_torque_Nm")}
     colloc["kiss_time_s"], colloc["kiss_speed_m_s"] = opt.terms.get("fill_time_s"), opt.terms.get("kiss_speed_m_s")
+    colloc["kiss_jerk_rad_s3"] = opt.terms.get("kiss_jerk_rad_s3")
     # IDAS locates lock-up to |w_rel| / w_scale <= event_value_tol; at the final slip rate that is:
     w_scale = max(ocp.scene.value("driveline.input_speed"), 1.0)
     rate = abs(opt.outputs["slip_acceleration_rad_s2"][-1])

@@ -67,15 +67,16 @@ def simulate_baselines(scene, lags=LAG_TIMES, ramp_time=RAMP_TIME):
 
 
 # -- the calibration shape "fill pulse, hold, ramp" -----------------------------------------------
-FILL_PULSE_KEYS = ("pulse_time_s", "hold_pressure_Pa", "hold_time_s", "ramp_rate_Pa_s")
+FILL_PULSE_KEYS = ("pulse_pressure_Pa", "pulse_time_s", "hold_pressure_Pa", "hold_time_s", "ramp_rate_Pa_s")
 
 
-def fill_pulse_command(pulse_time, hold_pressure, hold_time, ramp_rate, *, p_max, rate_limit, p_initial=0.0):
+def fill_pulse_command(pulse_pressure, pulse_time, hold_pressure, hold_time, ramp_rate, *, p_max, rate_limit,
+                       p_initial=0.0):
     """Nodes of the piecewise-linear command "fill pulse, hold, ramp" [s, Pa].
 
-    From ``p_initial`` the command rises at the rate limit to ``p_max`` (the fill pulse) and stays
-    there until ``pulse_time``, falls at the rate limit to ``hold_pressure``, holds it for
-    ``hold_time`` and then ramps at ``ramp_rate`` [Pa/s] up to ``p_max``; the same pressure and rate
+    From ``p_initial`` the command rises at the rate limit to ``pulse_pressure`` and stays there
+    until ``pulse_time`` (the fill pulse), moves at the rate limit to ``hold_pressure``, holds it for
+    ``hold_time`` and then ramps at ``ramp_rate`` [Pa/s] up to ``p_max``: the same pressure and rate
     limits as the optimum (a step is a ramp at the rate limit).
 
     Returns
@@ -83,13 +84,13 @@ def fill_pulse_command(pulse_time, hold_pressure, hold_time, ramp_rate, *, p_max
     (ndarray, ndarray)
         Times [s] and command values [Pa] of the nodes (linear in between, the last value after).
     """
-    rise = (p_max - p_initial) / rate_limit
+    rise = abs(pulse_pressure - p_initial) / rate_limit
     t1 = max(pulse_time, rise)
-    t2 = t1 + (p_max - hold_pressure) / rate_limit
+    t2 = t1 + abs(pulse_pressure - hold_pressure) / rate_limit
     t3 = t2 + hold_time
     t4 = t3 + (p_max - hold_pressure) / ramp_rate
     times = np.array([0.0, rise, t1, t2, t3, t4])
-    values = np.array([p_initial, p_max, p_max, hold_pressure, hold_pressure, p_max])
+    values = np.array([p_initial, pulse_pressure, pulse_pressure, hold_pressure, hold_pressure, p_max])
     keep = np.concatenate([[True], np.diff(times) > 1e-9])       # drop zero-length pieces
     return times[keep], values[keep]
 
@@ -99,11 +100,12 @@ def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=J
     """The "fill pulse, hold, ramp" command that locks up soonest with peak jerk <= ``jerk_cap`` and
     a lock-up jump within ``jump_limit`` of the locked torque (the conditions the optimum meets).
 
-    A Nelder-Mead search (scipy) over the four parameters of :func:`fill_pulse_command` (pulse time
-    0-40 ms, hold pressure 0-50 % of p_max, hold time 0-0.3 s, ramp rate 0.2-200 MPa/s on a log
-    scale), each candidate simulated with IDAS on the exact model; the cost is the lock-up time over
-    ``t_scale`` plus 20 x the relative excess of the peak jerk over the cap and 5 log(1 + e) of the
-    relative excess e of |jump| over ``jump_limit`` x the locked torque (100 if it never locks).
+    A Nelder-Mead search (scipy) over the five parameters of :func:`fill_pulse_command` (pulse
+    pressure 0-100 % of p_max, pulse time 0-40 ms, hold pressure 0-50 % of p_max, hold time 0-0.3 s,
+    ramp rate 0.2-200 MPa/s on a log scale), each candidate simulated with IDAS on the exact model;
+    the cost is the lock-up time over ``t_scale`` plus 50 log(1 + e_j) + 5 log(1 + e_s), with e_j the
+    relative excess of the peak jerk over the cap and e_s that of |jump| over ``jump_limit`` x the
+    locked torque (1000 if it never locks, so that any lock-up is better).
 
     Parameters
     ----------
@@ -137,7 +139,7 @@ def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=J
 
     def params(z):
         z = np.clip(z, 0.0, 1.0)
-        return (0.04 * z[0], 0.5 * p_max * z[1], 0.3 * z[2], 10 ** (5.3 + 3.0 * z[3]))
+        return (p_max * z[0], 0.04 * z[1], 0.5 * p_max * z[2], 0.3 * z[3], 10 ** (5.3 + 3.0 * z[4]))
 
     def evaluate(z):
         key = tuple(np.round(np.clip(z, 0.0, 1.0), 12))
@@ -146,18 +148,19 @@ def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=J
             run = simulate_command(scene, times, values, 4.0 * t_scale, model=model, control="linear", points=801)
             numbers = run_numbers(run)
             if numbers["engagement_time_s"] is None:
-                cost = 100.0
+                cost = 1000.0
             else:
                 excess = max(0.0, numbers["peak_jerk_rad_s3"] / jerk_cap - 1.0)
                 jump = abs(numbers["lockup_torque_jump_Nm"]) / (jump_limit * max(abs(numbers["locked_torque_Nm"]), 1e-9))
-                cost = numbers["engagement_time_s"] / t_scale + 20.0 * excess + 5.0 * np.log1p(max(0.0, jump - 1.0))
+                cost = (numbers["engagement_time_s"] / t_scale + 50.0 * np.log1p(excess)
+                        + 5.0 * np.log1p(max(0.0, jump - 1.0)))
             cache[key] = (cost, times, values, run, numbers)
             if progress and len(cache) % 10 == 0:
                 best = min(cache.values(), key=lambda c: c[0])
                 progress(f"  fill-pulse baseline search: {len(cache)} runs, best cost {best[0]:.4g}")
         return cache[key][0]
 
-    z0 = np.array([0.1, 0.3, 0.1, 0.2])
+    z0 = np.array([0.05, 0.25, 0.35, 0.1, 0.1])      # a soft fill (75 kPa for 10 ms), 0.5 MPa hold
     minimize(evaluate, z0, method="Nelder-Mead",
              options={"maxfev": max_evaluations, "initial_simplex": _simplex(z0), "xatol": 1e-3, "fatol": 1e-4})
     key, (cost, times, values, run, numbers) = min(cache.items(), key=lambda item: item[1][0])

@@ -7,9 +7,10 @@ Eq. 22 reset) -> slip (``pressing_*``) -> lock-up. Each phase is a
 :class:`~clutchocp.optimal.collocation.DirectCollocation` (own free duration T_k, own mesh); the
 phases are joined by link rows
 
-    x_start(k + 1) = reset_k(x_end(k)),      u_start(k + 1) = u_end(k)   (one continuous command),
+    x_start(k + 1) = reset_k(x_end(k)),      u_start(k + 1) = u_end(k),
 
-and, with more than one phase, one row for the total time sum_k T_k (its upper bound is the
+the second only for a piecewise-linear (continuous) command: a piecewise-constant command may change
+at a junction as at any interval boundary. With more than one phase one row carries the total time sum_k T_k (its upper bound is the
 engagement-time limit). A single phase has no link and no total-time row: its NLP vector and rows
 are those of its own transcription, so today's slip-phase problem is the one-phase case.
 
@@ -57,7 +58,8 @@ class PhasedNLP:
     phases : list of Phase
     links : list of casadi.Function
         One per junction: ``(x_end[n_x], x_start[n_x]) -> residual`` (zero when the start of the next
-        phase is the reset image of the end of this one). The command continuity rows are added here.
+        phase is the reset image of the end of this one). The command continuity rows (linear
+        control) are added here.
 
     Attributes
     ----------
@@ -135,7 +137,9 @@ class PhasedNLP:
         for k, link in enumerate(self.links):
             x_end, u_end, _, _, _ = self._ends(W, k)
             _, _, x_start, u_start, _ = self._ends(W, k + 1)
-            rows += [link(x_end, x_start), u_start - u_end]
+            rows.append(link(x_end, x_start))
+            if self.parts[k].transcription.control == "linear":
+                rows.append(u_start - u_end)
         return ca.vertcat(*rows) if rows else ca.MX(0, 1)
 
     def _total_time(self, W):

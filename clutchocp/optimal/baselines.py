@@ -160,7 +160,7 @@ def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=J
                 progress(f"  fill-pulse baseline search: {len(cache)} runs, best cost {best[0]:.4g}")
         return cache[key][0]
 
-    z0 = np.array([0.05, 0.25, 0.35, 0.1, 0.1])      # a soft fill (75 kPa for 10 ms), 0.5 MPa hold
+    z0 = np.array([0.05, 0.25, 0.35, 0.1, 0.1])      # a soft fill (75 kPa for 10 ms), 0.26 MPa hold
     minimize(evaluate, z0, method="Nelder-Mead",
              options={"maxfev": max_evaluations, "initial_simplex": _simplex(z0), "xatol": 1e-3, "fatol": 1e-4})
     key, (cost, times, values, run, numbers) = min(cache.items(), key=lambda item: item[1][0])

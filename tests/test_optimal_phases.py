@@ -95,7 +95,8 @@ def test_impact_reset_in_the_ocp_equals_the_simulators():
     """bao2020 (plate masses): Bao Eq. 22 as the OCP link applies it, against the IDAS event record."""
     scene = load_scene("bao2020", {"actuation.max_pressure": "80 MPa"})
     run = simulate_engagement(scene)
-    ocp = EngagementOCP(scene, intervals=4, fill_intervals=2, degree=2, baseline=run, polish=False)
+    ocp = EngagementOCP(scene, intervals=4, fill_intervals=2, degree=2, baseline=run, polish=False,
+                        quasi_static_plates=False)
     impact = next(e for e in run.result.events if e.name == "impact")
     names, nominal = ocp.state_names, ocp.nominal
 

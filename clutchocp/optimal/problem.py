@@ -156,7 +156,10 @@ class EngagementOCP:
         Number of collocation intervals of the fill phase (scenes with free piston travel).
     jerk_max : float, optional
         Largest |jerk| [rad/s^3] of the jerk term's signal (output; input for a held output) at every
-        collocation point (default: none).
+        collocation point and just after the kiss (default: none).
+    quasi_static_plates : bool, optional
+        Take plate masses (``pack.model = "masses"``) as massless in the OCP (default: yes for such a
+        scene); the verification replays the optimum on the full model.
     degree : int
         Collocation points per interval.
     scheme : {"radau", "legendre"}
@@ -186,7 +189,7 @@ class EngagementOCP:
 
     def __init__(self, scene, *, intervals=100, degree=3, scheme="radau", control="linear", rate_limit=None,
                  h_min=None, jump="constraint", lock_margin=0.005, smooth=True, polish=True,
-                 transcription=None, baseline=None, fill_intervals=30, jerk_max=None):
+                 transcription=None, baseline=None, fill_intervals=30, jerk_max=None, quasi_static_plates=None):
         if jump not in JUMP_MODES:
             raise ModelError(f"jump '{jump}': allowed values are {', '.join(JUMP_MODES)}")
         if scene.kind != "engagement":
@@ -205,14 +208,23 @@ class EngagementOCP:
             raise ModelError(f"jerk_max = {jerk_max!r}: must be a positive jerk [rad/s^3]")
         self.options = {"intervals": intervals, "degree": degree, "scheme": scheme, "control": control,
                         "rate_limit": rate_limit, "h_min": h_min, "jump": jump, "lock_margin": lock_margin,
-                        "fill_intervals": fill_intervals, "jerk_max": jerk_max}
+                        "fill_intervals": fill_intervals, "jerk_max": jerk_max,
+                        "quasi_static_plates": quasi_static_plates}
         self.jerk_max = jerk_max
         self.u = ca.SX.sym("pressure_command")
         self.lock_margin = float(lock_margin)
         self.smooth = bool(smooth)
         self.polish = bool(polish) and self.smooth
         self._exact = None
-        self.model = EngagementModel(scene, smooth=smooth, pressure_command=self.u)
+        # Plate masses: their axial dynamics is 1e5-1e8 times faster than the slip (overdamped by the
+        # squeeze films, see PHYSICS.md), which no collocation mesh of the engagement resolves; the
+        # OCP takes the plates as massless (quasi-static) by default and IDAS verifies the optimum on
+        # the full model with its masses and the Bao Eq. 22 impact.
+        masses = scene.variant("pack") == "masses"
+        self.quasi_static_plates = masses if quasi_static_plates is None else bool(quasi_static_plates) and masses
+        ocp_scene = scene.with_overrides({"pack.model": "massless", "pack.plate_masses": None}) \
+            if self.quasi_static_plates else scene
+        self.model = EngagementModel(ocp_scene, smooth=smooth, pressure_command=self.u)
         start_mode = self.model.initial_mode()
         if start_mode not in (SLIP_MODE, FILL_MODE):
             raise ModelError(f"scene '{scene.name}' starts in mode '{start_mode}'; the optimisation covers an "
@@ -429,6 +441,11 @@ class EngagementOCP:
             if name.startswith("h_"):
                 x_lb[i] = (self.h_min or 0.0) / self.nominal[i]
         if role == "fill":
+            # The piston stays between its rest position (the model has no stop: 1 % of the stroke
+            # back is allowed) and the pack.
+            i_x0 = self._names.index("x0")
+            x_lb[i_x0] = -0.01 * self.model.travel / self.nominal[i_x0]
+            x_ub[i_x0] = self.model.travel / self.nominal[i_x0]
             end_lb, end_ub = np.zeros(1), np.zeros(1)
             if self.jerk_max is not None:
                 end_lb, end_ub = np.array([0.0, -1.0]), np.array([0.0, 1.0])
@@ -612,7 +629,7 @@ class EngagementOCP:
                  f"{stats['iterations']} iterations")
         if status == "Infeasible_Problem_Detected":
             hint = (f"no command within the pressure and rate limits locks up by t_max with the end conditions "
-                    f"(the fastest lock-up, a step to the pressure limit, takes {self.fastest_lockup():.4g} s); "
+                    f"(the fastest lock-up, a step to {self._apply_label()}, takes {self.fastest_lockup():.4g} s); "
                     f"raise t_max, e_max or the limits")
         elif status == "Maximum_Iterations_Exceeded":
             hint = "start from a nearby solution (warm start) or use fewer intervals"
@@ -708,25 +725,38 @@ class EngagementOCP:
     # -- feasibility ----------------------------------------------------------------------------
     def default_t_max(self):
         """The baseline's lock-up time (no slower than the scene's own profile), or 1.5 x the fastest
-        lock-up if the baseline does not lock up [s]."""
+        lock-up if the baseline does not lock up or is itself the fastest lock-up (bao2020: the spring
+        applies the clutch at once; no smooth lock-up can be as fast) [s]."""
         t_lock = self.baseline.summary["engagement_time_s"]
-        return t_lock if t_lock is not None else 1.5 * self.fastest_lockup()
+        if t_lock is None or t_lock <= 1.001 * self.fastest_lockup():
+            return 1.5 * self.fastest_lockup()
+        return t_lock
 
     def fastest_run(self):
-        """IDAS run of a step of the command to the pressure limit (cached)."""
+        """IDAS run of a step of the command to the pressure that applies the clutch hardest (cached):
+        the pressure limit, or zero for a spring-applied piston (the pressure releases it)."""
         if self._fastest is None:
             from .replay import simulate_command
             t_end = self.scene.value("simulation.t_end")
-            run = simulate_command(self.scene, [0.0], [self.p_max], t_end)
+            run = simulate_command(self.scene, [0.0], [self.apply_pressure], t_end)
             if run.summary["engagement_time_s"] is None:
-                raise ModelError(f"scene '{self.scene.name}': even a step to actuation.max_pressure = "
-                                 f"{self.p_max / 1e6:.3g} MPa does not lock up within simulation.t_end = "
-                                 f"{t_end:g} s; raise the pressure limit or t_end")
+                raise ModelError(f"scene '{self.scene.name}': even a step to {self._apply_label()} does not lock "
+                                 f"up within simulation.t_end = {t_end:g} s; raise the pressure limit or t_end")
             self._fastest = run
         return self._fastest
 
+    @property
+    def apply_pressure(self):
+        """Command that applies the clutch hardest [Pa]: 0 for a spring-applied piston, else the limit."""
+        spring_applied = self.model.has_piston and self.scene.variant("piston") == "spring_applied"
+        return 0.0 if spring_applied else self.p_max
+
+    def _apply_label(self):
+        return "zero pressure (spring-applied)" if self.apply_pressure == 0.0 else \
+            f"actuation.max_pressure = {self.p_max / 1e6:.3g} MPa"
+
     def fastest_lockup(self):
-        """Lock-up time [s] of a step to the pressure limit (no profile under the limit locks sooner)."""
+        """Lock-up time [s] of a step to :attr:`apply_pressure` (no command within the limits locks sooner)."""
         return self.fastest_run().summary["engagement_time_s"]
 
     def check_feasible_time(self, t_max):
@@ -736,5 +766,5 @@ class EngagementOCP:
         fastest = self.fastest_lockup()
         if t_max < fastest:
             raise ModelError(f"t_max = {t_max:.4g} s is below the fastest lock-up the pressure limit allows "
-                             f"({fastest:.4g} s with a step to actuation.max_pressure = {self.p_max / 1e6:.3g} MPa); "
+                             f"({fastest:.4g} s with a step to {self._apply_label()}); "
                              f"raise t_max or the pressure limit")

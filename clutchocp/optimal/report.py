@@ -83,6 +83,7 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         "baseline": dict(run_numbers(ocp.baseline), profile=baseline_label(scene)),
         "baselines": {name: numbers for name, (_, numbers) in baselines.items()},
         "verification": {k: check[k] for k in ("lock_time_rel_diff", "lock_time_resolution_s", "torque_jump_Nm",
+                                              "jump_reference_Nm",
                                               "torque_jump_rel", "passed", "holding_pressure_Pa", "collocation",
                                               "idas")},
         "jerk_lower_bound": bound,

@@ -1,7 +1,5 @@
 """Phased collocation: the one-phase case, the fill phase and its impact link, a brake, a closed-form fill."""
 
-import json
-
 import casadi as ca
 import numpy as np
 import pytest
@@ -12,6 +10,7 @@ from clutchocp.cli import main
 from clutchocp.engagement.run import simulate_engagement
 from clutchocp.errors import ModelError
 from clutchocp.optimal import DirectCollocation, EngagementOCP, StagedProblem, nlp_solver, verify
+from clutchocp.optimal.guess import guess_from_run
 from clutchocp.optimal.phases import Phase, PhasedNLP, phased_derivatives
 from clutchocp.scene import default_scene, load_scene
 
@@ -76,9 +75,9 @@ def test_fill_optimum_is_confirmed_by_idas(fill_ocp, fill_opt):
 def test_phased_derivatives_equal_casadi_ad(fill_scene, fill_ocp):
     small = EngagementOCP(fill_scene, intervals=3, fill_intervals=2, degree=2, baseline=fill_ocp.baseline,
                           jerk_max=5e3)
-    from clutchocp.optimal.guess import guess_from_run
     nlp = small.phased
-    reference = ca.nlpsol("reference", "ipopt", nlp.nlp, {"print_time": False, "ipopt": {"print_level": 0, "sb": "yes"}})
+    reference = ca.nlpsol("reference", "ipopt", nlp.nlp,
+                          {"print_time": False, "ipopt": {"print_level": 0, "sb": "yes"}})
     mine = phased_derivatives(nlp)
     rng = np.random.default_rng(5)
     w = guess_from_run(small, fill_ocp.baseline) * (1 + 0.01 * rng.normal(size=nlp.lbx.size))

@@ -151,7 +151,8 @@ def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=J
                 cost = 1000.0
             else:
                 excess = max(0.0, numbers["peak_jerk_rad_s3"] / jerk_cap - 1.0)
-                jump = abs(numbers["lockup_torque_jump_Nm"]) / (jump_limit * max(abs(numbers["locked_torque_Nm"]), 1e-9))
+                locked = max(abs(numbers["locked_torque_Nm"]), 1e-9)
+                jump = abs(numbers["lockup_torque_jump_Nm"]) / (jump_limit * locked)
                 cost = (numbers["engagement_time_s"] / t_scale + 50.0 * np.log1p(excess)
                         + 5.0 * np.log1p(max(0.0, jump - 1.0)))
             cache[key] = (cost, times, values, run, numbers)

@@ -125,7 +125,8 @@ def guess_from_optimum(ocp, opt, t_max=None):
         t_old = (opt.t[a:b] - t0) / (t1 - t0)
 
         def states_at(s, a=a, b=b, t_old=t_old):
-            cols = [np.interp(s, t_old, opt.states[nm][a:b]) / nominal for nm, nominal in zip(ocp.state_names, ocp.nominal)]
+            cols = [np.interp(s, t_old, opt.states[nm][a:b]) / nominal
+                    for nm, nominal in zip(ocp.state_names, ocp.nominal)]
             cols.append(np.interp(s, t_old, opt.outputs["dissipated_energy_J"][a:b]) / ocp.scales.energy_J)
             return np.stack(cols, axis=-1)
 

@@ -10,8 +10,8 @@ phases are joined by link rows
     x_start(k + 1) = reset_k(x_end(k)),      u_start(k + 1) = u_end(k),
 
 the second only for a piecewise-linear (continuous) command: a piecewise-constant command may change
-at a junction as at any interval boundary. With more than one phase one row carries the total time sum_k T_k (its upper bound is the
-engagement-time limit). A single phase has no link and no total-time row: its NLP vector and rows
+at a junction as at any interval boundary. With more than one phase one row carries the total time
+sum_k T_k (its upper bound is the engagement-time limit). A single phase has no link and no total-time row: its NLP vector and rows
 are those of its own transcription, so today's slip-phase problem is the one-phase case.
 
 Exact derivatives: each phase's Jacobian and Hessian come from
@@ -129,8 +129,9 @@ class PhasedNLP:
         n_x, n_u = part.problem.n_x, part.problem.n_u
         (xs, _), (us, (n_ctrl, _)) = part.layout["x"], part.layout["u"]
         N = part.transcription.intervals
-        return (W[off + xs + N * n_x:off + xs + (N + 1) * n_x], W[off + us + (n_ctrl - 1) * n_u:off + us + n_ctrl * n_u],
-                W[off + xs:off + xs + n_x], W[off + us:off + us + n_u], W[off + part.t_slice.stop - 1])
+        x_end = W[off + xs + N * n_x:off + xs + (N + 1) * n_x]
+        u_end = W[off + us + (n_ctrl - 1) * n_u:off + us + n_ctrl * n_u]
+        return x_end, u_end, W[off + xs:off + xs + n_x], W[off + us:off + us + n_u], W[off + part.t_slice.stop - 1]
 
     def _link_rows(self, W):
         rows = []

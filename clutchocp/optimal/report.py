@@ -168,7 +168,8 @@ def _fill_comparison(ocp, opt, check, command_model, intervals, degree, say):
         "optimal_faster": bool(base["engagement_time_s"] is None
                                or numbers["engagement_time_s"] < base["engagement_time_s"]),
     }
-    say(f"  minimum time: {_fmt(numbers['engagement_time_s'], 's')} (kiss speed {_fmt(numbers['kiss_speed_m_s'], 'm/s')}) "
+    say(f"  minimum time: {_fmt(numbers['engagement_time_s'], 's')} "
+        f"(kiss speed {_fmt(numbers['kiss_speed_m_s'], 'm/s')}) "
         f"against the tuned fill pulse {_fmt(base['engagement_time_s'], 's')} "
         f"(kiss speed {_fmt(base['kiss_speed_m_s'], 'm/s')})")
     return {"summary": summary, "optimal_run": fast_run, "baseline_run": tuned["run"], "baseline": tuned}
@@ -300,7 +301,8 @@ def plot_piston(out, scene, replay, baseline):
     travel = scene.get("piston.travel_to_pack", 0.0)
     if travel > 0:
         ax1.axhline(travel * 1e3, color="k", lw=0.8, ls=":", label="kiss point (pack reached)")
-    ax1.set(xlabel="time [ms]", ylabel="piston travel [mm]", title=f"{scene.name}: piston stroke", xlim=(0, t_end * 1e3))
+    ax1.set(xlabel="time [ms]", ylabel="piston travel [mm]", title=f"{scene.name}: piston stroke",
+            xlim=(0, t_end * 1e3))
     ax2.set(xlabel="time [ms]", ylabel="force [N]", title="spring force and hydraulic force", xlim=(0, t_end * 1e3))
     ax1.legend(fontsize=7)
     ax2.legend(fontsize=7)
@@ -319,7 +321,8 @@ def plot_fill_comparison(out, scene, fill):
     """Pressure, torque and jerk of the minimum-time optimum against the tuned fill pulse (both IDAS)."""
     fig, axes = new_figure(3, width=4.2)
     cap = fill["summary"]["jerk_cap_rad_s3"]
-    runs = (("minimum-time optimum", fill["optimal_run"], "C0"), ("tuned fill pulse, hold, ramp", fill["baseline_run"], "C3"))
+    runs = (("minimum-time optimum", fill["optimal_run"], "C0"),
+            ("tuned fill pulse, hold, ramp", fill["baseline_run"], "C3"))
     for label, run, color in runs:
         res = run.result
         t_lock = run.summary["engagement_time_s"]

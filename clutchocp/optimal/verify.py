@@ -77,8 +77,10 @@ def jump_reference(ocp, numbers):
 
 
 def holding_pressure(ocp, opt):
-    """Command after lock-up [Pa]: the larger of the last command and the scene's set pressure."""
-    return float(max(opt.command[-1], ocp.scene.value("actuation.pressure")))
+    """Command after lock-up [Pa]: the larger of the last command and the scene's set pressure (the
+    smaller for a spring-applied piston, where pressure releases the clutch)."""
+    pick = min if ocp.apply_pressure == 0.0 else max
+    return float(pick(opt.command[-1], ocp.scene.value("actuation.pressure")))
 
 
 def verify(ocp, opt, *, model=None, rtol=None, atol=None):

@@ -210,3 +210,17 @@ def test_optimize_set_overrides_the_scene(capsys, tmp_path):
 def test_jerk_limit_is_checked():
     with pytest.raises(ModelError, match="jerk_max"):
         EngagementOCP(default_scene(), intervals=5, jerk_max=-1.0)
+
+
+@pytest.mark.slow
+def test_quasi_static_plates_match_the_plate_masses_of_bao2020():
+    """The OCP takes bao2020's plates as massless: under the same release command IDAS gives the same
+    kiss and lock-up with and without the plate masses (their dynamics is far faster than the slip)."""
+    from clutchocp.optimal.replay import simulate_command
+    scene = load_scene("bao2020", {"actuation.initial_pressure": "63.66 MPa"})
+    massless = scene.with_overrides({"pack.model": "massless", "pack.plate_masses": None})
+    runs = [simulate_command(s, [0.0, 0.3], [63.66e6, 0.0], 1.0, control="linear") for s in (scene, massless)]
+    locks = [r.summary["engagement_time_s"] for r in runs]
+    kisses = [next(e.t for e in r.result.events if e.name == "impact") for r in runs]
+    assert locks[0] == pytest.approx(locks[1], rel=1e-4)
+    assert kisses[0] == pytest.approx(kisses[1], rel=1e-4)

@@ -209,12 +209,18 @@ def parse_weights(text, option="--weights"):
 def _cmd_optimize(args):
     from .optimal.problem import check_weights
     from .optimal.report import run_optimize
+    from .scene import default_scene, load_scene, parse_override
 
+    overrides = dict(parse_override(text) for text in args.set)
+    if args.scene is None:
+        scene = default_scene().with_overrides(overrides) if overrides else default_scene()
+    else:
+        scene = load_scene(args.scene, overrides=overrides)
     weights = parse_weights(args.weights) if args.weights is not None else None
     if weights is not None:
         check_weights(weights)             # before any solving
     sweep = parse_time_list(args.sweep_t_max, "--sweep-t-max") if args.sweep_t_max is not None else None
-    run_optimize(args.scene, out_dir=args.out, t_max=args.t_max, weights=weights,
+    run_optimize(scene, out_dir=args.out, t_max=args.t_max, weights=weights,
                  intervals=args.intervals, degree=args.degree, sweep_t_max=sweep,
                  max_temperature_C=args.max_temperature, max_specific_power_W_mm2=args.max_specific_power)
     return 0
@@ -270,13 +276,17 @@ def build_parser():
     p = sub.add_parser("optimize", help="optimal engagement pressure by direct collocation (the main job)")
     p.add_argument("scene", nargs="?", default=None, help="engagement scene (default: the default scene)")
     p.add_argument("--out", default="out/optimize", help="output folder (default: out/optimize)")
+    p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
+                   help="override a scene value, e.g. --set actuation.max_pressure='1.2 MPa' (repeatable)")
     p.add_argument("--t-max", type=time_limit, default=None, help="largest engagement time [s]")
     p.add_argument("--weights", default=None, metavar="NAME=W,...",
                    help="objective weights; the objective is jerk*J/J_ref + energy*E/E_ref + time*T/T_ref "
-                        "+ jump*(jump/M_ref)^2 + smooth*S/S_ref, each term scaled to about 1 on the "
-                        "scene's baseline (see README). Defaults: jerk=1, energy=0, time=0, jump=0, "
+                        "+ jump*(jump/M_ref)^2 + smooth*S/S_ref (+ fill_time*T_fill/T_ref + "
+                        "kiss_speed*(v_kiss/v_ref)^2 on a scene with a fill phase), each term scaled to about 1 "
+                        "on the scene's baseline (see README). Defaults: jerk=1, energy=0, time=0, jump=0, "
                         "smooth=0.1 (a penalty on the command's rate that keeps the command smooth; set "
-                        "smooth=0 when time or energy is the goal). Names not given keep their default")
+                        "smooth=0 when time or energy is the goal), fill_time=0, kiss_speed=0. "
+                        "Names not given keep their default")
     p.add_argument("--intervals", type=count(2, MAX_INTERVALS, "collocation intervals"), default=100,
                    help=f"collocation intervals, 2 ... {MAX_INTERVALS} (default: 100)")
     p.add_argument("--degree", type=count(1, 9, "collocation points per interval"), default=3,

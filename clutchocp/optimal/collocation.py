@@ -90,8 +90,8 @@ class StagedProblem:
     dynamics : casadi.Function
         ``(x[n_x], u[n_u], p[n_p]) -> (xdot[n_x], q[n_q], c[n_c])``: state derivative per unit
         (scaled) time, integrands of the objective integrals Q and path expressions c.
-    x0 : array (n_x,)
-        Initial state (fixed).
+    x0 : array (n_x,) or None
+        Initial state (fixed); None: free (a later phase, whose start is linked to the phase before).
     objective : casadi.Function
         ``(x_f[n_x], u_f[n_u], Q[n_q], T, p[n_p]) -> J`` (u_f: the last control value).
     end : casadi.Function
@@ -312,7 +312,8 @@ class DirectCollocation:
                               np.tile(problem.u_lb, self.n_controls), np.zeros(N)])
         ubx = np.concatenate([np.tile(problem.x_ub, N + 1), np.tile(problem.x_ub, N * d),
                               np.tile(problem.u_ub, self.n_controls), np.full(N, np.inf)])
-        lbx[:n_x] = ubx[:n_x] = problem.x0
+        if problem.x0 is not None:
+            lbx[:n_x] = ubx[:n_x] = problem.x0
         if problem.u_rate is not None and problem.u_initial is not None and self.control == "linear":
             start = layout["u"][0]                                  # no step at s = 0 either
             lbx[start:start + n_u] = ubx[start:start + n_u] = problem.u_initial

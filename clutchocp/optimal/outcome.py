@@ -22,6 +22,9 @@ class OptimizationResult:
         The optimal command re-simulated with IDAS.
     baselines : dict
         ``{label: (EngagementResult, numbers)}`` of the step, ramp and lag profiles.
+    fill : dict or None
+        On a scene with a fill phase: the minimum-time optimum against the tuned "fill pulse, hold,
+        ramp" baseline (``summary``, ``optimal_run``, ``baseline_run``); None otherwise.
     """
 
     scene: object
@@ -30,6 +33,7 @@ class OptimizationResult:
     optimum: object
     replay: object
     baselines: dict = field(default_factory=dict)
+    fill: dict = None
 
     def __repr__(self):
         s = self.summary

@@ -1,7 +1,13 @@
-"""The optimal-control problem of an engagement: the pressure command over the slip phase.
+"""The optimal-control problem of an engagement: one pressure command over its phases.
 
-Over the slip phase (mode ``pressing_slip_forward`` of :class:`~clutchocp.engagement.model.EngagementModel`)
-the pressure command u(t) is chosen to minimise
+The engagement follows the modes of :class:`~clutchocp.engagement.model.EngagementModel` as a
+sequence of phases (:mod:`clutchocp.optimal.phases`): with free piston travel a ``fill`` phase
+(mode ``approach_slip_forward``: the piston strokes against its return spring, plates at rest) that
+ends when the piston reaches the pack (x0 = travel, the kiss point), the impact reset (Bao Eq. 22,
+the simulator's own reset map), then the ``slip`` phase (mode ``pressing_slip_forward``) up to
+lock-up. Without free travel the slip phase is the only phase, and the problem is the one below.
+
+Over the slip phase the pressure command u(t) is chosen to minimise
 
     J = w_jerk int jerk^2 dt / J_ref + w_energy E / E_ref + w_time t_f / t_ref
         + w_jump (jump / T_ref)^2 + w_smooth int (dp/dt)^2 dt t_ref / p_ref^2
@@ -19,6 +25,19 @@ slipping torque is the locked one, w_rel'' = 0 because that torque is not fallin
 then ill-conditioned (a slip error e moves it by ~e^(1/3); measured: 0.8 % late in IDAS). The default
 margin of 0.5 % makes the crossing transversal (measured: IDAS locks at the collocation time within
 its event tolerance) and leaves a jump of -0.5 % of the locked torque.
+
+The fill phase adds w_jerk and w_smooth integrals of the same kind, its duration to the time term,
+and two terms of its own: w_fill_time t_fill / t_ref and w_kiss_speed (v_kiss / v_ref)^2 with the
+piston speed at the kiss point v_kiss (Bao 2020 blames the collision speed for shift shock) and v_ref
+the kiss speed of the reference run.
+
+A clutch whose locked driveline carries no torque (a brake with its output held, zhang2021; a
+prescribed input speed with no load, bao2020) meets lock-up as the moving side coming to rest
+relative to the other; its lock-up jump is the torque step at that instant, the slipping torque
+before it (after it the clutch carries nothing). Its end condition asks for a slipping torque of
+lock_margin x the peak torque of the reference run (transversal: the slip still falls at t_f), and
+it has no holding condition (a lock that carries nothing always holds). With the output held the jerk
+term is the jerk of the input (the braked inertia), as the output does not move.
 
 Constraints: t_f <= t_max, E <= E_max, films h >= h_min, 0 <= u <= actuation.max_pressure,
 |du/dt| <= rate limit, w_rel >= 0; optionally interface temperature <= max_temperature_C (a scene
@@ -51,14 +70,17 @@ from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
 from .bound import jerk_lower_bound, output_jerk_share
 from .collocation import DirectCollocation, StagedProblem
-from .derivatives import nlp_solver, structured_derivatives
+from .derivatives import nlp_solver
 from .heat import heat_limits
+from .phases import Phase, PhasedNLP, phased_derivatives
 
-OBJECTIVE_TERMS = ("jerk", "energy", "time", "jump", "smooth")
-DEFAULT_WEIGHTS = {"jerk": 1.0, "energy": 0.0, "time": 0.0, "jump": 0.0, "smooth": 0.1}
+OBJECTIVE_TERMS = ("jerk", "energy", "time", "jump", "smooth", "fill_time", "kiss_speed")
+DEFAULT_WEIGHTS = {"jerk": 1.0, "energy": 0.0, "time": 0.0, "jump": 0.0, "smooth": 0.1, "fill_time": 0.0,
+                   "kiss_speed": 0.0}
 SMOOTH_PER_JERK = 0.1        # default smooth weight per unit jerk weight (see the module notes)
 JUMP_MODES = ("constraint", "penalty")
 SLIP_MODE = "pressing_slip_forward"
+FILL_MODE = "approach_slip_forward"
 
 
 def check_weights(weights):
@@ -79,8 +101,8 @@ def check_weights(weights):
         out[name] = value
     if "smooth" not in (weights or {}):
         out["smooth"] = SMOOTH_PER_JERK * out["jerk"]
-    if sum(out[k] for k in ("jerk", "energy", "time", "jump")) == 0:
-        raise ModelError("weights: at least one of jerk, energy, time, jump must be positive")
+    if sum(out[k] for k in ("jerk", "energy", "time", "jump", "fill_time", "kiss_speed")) == 0:
+        raise ModelError("weights: at least one of jerk, energy, time, jump, fill_time, kiss_speed must be positive")
     return out
 
 
@@ -93,6 +115,7 @@ class Scales:
     jerk_integral: float
     torque_Nm: float
     pressure_Pa: float
+    speed_m_s: float = 1.0
 
 
 @dataclass
@@ -102,6 +125,9 @@ class OptimalEngagement:
     ``t`` are the interval starts (N + 1), ``t_points`` the collocation times (N, d);
     ``states`` and ``outputs`` hold arrays at the interval starts (``*_points`` at the collocation
     points); ``command`` the command values (N, or N + 1 for a linear command) on ``command_times``.
+    With several phases these run over all phases in turn (the node at a phase link appears twice,
+    before and after the reset; the command once); ``phases`` lists each phase's name, mode, start
+    and end time [s] and its node range in ``t``.
     """
 
     t_f: float
@@ -122,6 +148,7 @@ class OptimalEngagement:
     weights: dict = field(default_factory=dict)
     t_max: float | None = None
     e_max: float | None = None
+    phases: list = field(default_factory=list)
 
     @property
     def success(self):
@@ -138,10 +165,18 @@ class EngagementOCP:
     Parameters
     ----------
     scene : clutchocp.scene.Scene
-        An engagement scene whose pack is pressed from t = 0 (no free piston travel), with
-        ``actuation.max_pressure``.
+        An engagement scene that starts slipping forward (w_in > w_out), with ``actuation.max_pressure``.
+        With free piston travel the problem has a fill phase before the slip phase.
     intervals : int
-        Number of collocation intervals N.
+        Number of collocation intervals N of the slip phase.
+    fill_intervals : int
+        Number of collocation intervals of the fill phase (scenes with free piston travel).
+    jerk_max : float, optional
+        Largest |jerk| [rad/s^3] of the jerk term's signal (output; input for a held output) at every
+        collocation point and just after the kiss (default: none).
+    quasi_static_plates : bool, optional
+        Take plate masses (``pack.model = "masses"``) as massless in the OCP (default: yes for such a
+        scene); the verification replays the optimum on the full model.
     degree : int
         Collocation points per interval.
     scheme : {"radau", "legendre"}
@@ -175,7 +210,8 @@ class EngagementOCP:
 
     def __init__(self, scene, *, intervals=100, degree=3, scheme="radau", control="linear", rate_limit=None,
                  h_min=None, jump="constraint", lock_margin=0.005, smooth=True, polish=True,
-                 transcription=None, baseline=None, max_temperature_C=None, max_specific_power_W_mm2=None):
+                 transcription=None, baseline=None, fill_intervals=30, jerk_max=None, quasi_static_plates=None,
+                 max_temperature_C=None, max_specific_power_W_mm2=None):
         if jump not in JUMP_MODES:
             raise ModelError(f"jump '{jump}': allowed values are {', '.join(JUMP_MODES)}")
         if scene.kind != "engagement":
@@ -185,26 +221,45 @@ class EngagementOCP:
         self.jump_mode = jump
         self.p_max = scene.get("actuation.max_pressure")
         if self.p_max is None:
-            raise ModelError("actuation.max_pressure: the optimisation needs an upper pressure limit; "
-                             "add e.g. max_pressure = \"1.5 MPa\" to [actuation]")
+            raise ModelError("actuation.max_pressure: the optimisation needs an upper pressure limit; set it "
+                             "with --set actuation.max_pressure='1.5 MPa' or add max_pressure = \"1.5 MPa\" to "
+                             "[actuation]")
         if not (np.isfinite(lock_margin) and 0 <= lock_margin < 0.5):
             raise ModelError(f"lock_margin = {lock_margin!r}: must be a fraction in [0, 0.5)")
+        if jerk_max is not None and not (np.isfinite(jerk_max) and jerk_max > 0):
+            raise ModelError(f"jerk_max = {jerk_max!r}: must be a positive jerk [rad/s^3]")
         self.options = {"intervals": intervals, "degree": degree, "scheme": scheme, "control": control,
                         "rate_limit": rate_limit, "h_min": h_min, "jump": jump, "lock_margin": lock_margin,
-                        "max_temperature_C": max_temperature_C, "max_specific_power_W_mm2": max_specific_power_W_mm2}
+                        "fill_intervals": fill_intervals, "jerk_max": jerk_max,
+                        "quasi_static_plates": quasi_static_plates, "max_temperature_C": max_temperature_C,
+                        "max_specific_power_W_mm2": max_specific_power_W_mm2}
+        self.jerk_max = jerk_max
         self.u = ca.SX.sym("pressure_command")
         self.lock_margin = float(lock_margin)
         self.smooth = bool(smooth)
         self.polish = bool(polish) and self.smooth
         self._exact = None
-        self.model = EngagementModel(scene, smooth=smooth, pressure_command=self.u)
+        # Plate masses: their axial dynamics is 1e5-1e8 times faster than the slip (overdamped by the
+        # squeeze films, see PHYSICS.md), which no collocation mesh of the engagement resolves; the
+        # OCP takes the plates as massless (quasi-static) by default and IDAS verifies the optimum on
+        # the full model with its masses and the Bao Eq. 22 impact.
+        masses = scene.variant("pack") == "masses"
+        self.quasi_static_plates = masses if quasi_static_plates is None else bool(quasi_static_plates) and masses
+        ocp_scene = scene.with_overrides({"pack.model": "massless", "pack.plate_masses": None}) \
+            if self.quasi_static_plates else scene
+        self.model = EngagementModel(ocp_scene, smooth=smooth, pressure_command=self.u)
         self.heat_limits = heat_limits(self.model, max_temperature_C, max_specific_power_W_mm2)
         start_mode = self.model.initial_mode()
-        if start_mode != SLIP_MODE:
-            raise ModelError(f"scene '{scene.name}' starts in mode '{start_mode}'; the optimisation covers a "
-                             f"slip phase that starts with the pack pressed and w_in > w_out "
-                             f"(no free piston travel, input_speed > output_speed)")
+        if start_mode not in (SLIP_MODE, FILL_MODE):
+            raise ModelError(f"scene '{scene.name}' starts in mode '{start_mode}'; the optimisation covers an "
+                             f"engagement that starts slipping forward (driveline.input_speed > output_speed)")
         self.transcription = transcription or DirectCollocation(intervals, degree, scheme, control)
+        # Phases (name, mode): the fill phase first if the piston starts with free travel.
+        self.phase_modes = ([("fill", FILL_MODE)] if start_mode == FILL_MODE else []) + [("slip", SLIP_MODE)]
+        self.fill_transcription = DirectCollocation(fill_intervals, degree, scheme, control) \
+            if start_mode == FILL_MODE else None
+        # Output held (a brake): the braked side is the input; its jerk is the one felt.
+        self.output_held = not self.model.output_inertia and self.model.input_inertia
         self.baseline = baseline if baseline is not None else simulate_engagement(scene)
         self._fastest = None
         # The run that seeds the first solve and sets the scales: the baseline if it locks up.
@@ -214,7 +269,7 @@ class EngagementOCP:
         if not self.rate_limit > 0:
             raise ModelError(f"rate_limit = {rate_limit!r}: must be a positive rate [Pa/s]")
         self.h_min = h_min
-        self.output_jerk_share = output_jerk_share(scene)
+        self.output_jerk_share = 1.0 if self.output_held else output_jerk_share(scene)
         self.has_valve = self.model.actuation.has_state
         self.state_groups = self._state_groups()
         self.state_names = tuple(self.state_groups)  # the NLP adds the dissipated energy as a last state
@@ -223,8 +278,14 @@ class EngagementOCP:
         self.nominal = self.model.nominal[self._phys]
         self.x0 = self.model.initial_state[self._phys]
         self.scales = self._scales()
-        self._build_functions()
-        self.nlp = self.transcription.transcribe(self._staged_problem())
+        self.phase_functions = {"slip": self._build_functions(SLIP_MODE, "slip")}
+        if self.phase_modes[0][0] == "fill":
+            self.kiss_jerk_fn = self._kiss_jerk_fn()
+            self.phase_functions["fill"] = self._build_functions(FILL_MODE, "fill")
+        for key, fn in self.phase_functions["slip"].items():     # the slip phase's blocks, as before
+            setattr(self, key, fn)
+        self.phased = self._phased_nlp()
+        self.nlp = self.phased.parts[0] if len(self.phased.parts) == 1 else self.phased
         self._solvers = {}
         self._derivatives = None
 
@@ -268,8 +329,20 @@ class EngagementOCP:
         w_rel0, rate0 = self.initial_slip()
         locked0 = float(ca.Function("locked", [self.model.x], [self.model.locked_torque()])(self.model.initial_state))
         jerk_ref = jerk_lower_bound(w_rel0, rate0, t_ref) * max(self.output_jerk_share, 1e-3) ** 2
+        peak = summary["peak_torque_Nm"]
+        # A lock that carries (almost) no torque: the jump is the slipping torque before it, measured
+        # against the peak torque of the reference run.
+        self.holds_torque = abs(locked0) > 0.01 * peak
+        torque = max(abs(locked0), 1.0) if self.holds_torque else peak
         return Scales(time_s=t_ref, energy_J=max(summary["dissipated_energy_J"], 1e-6), jerk_integral=jerk_ref,
-                      torque_Nm=max(abs(locked0), 1.0), pressure_Pa=self.p_max)
+                      torque_Nm=torque, pressure_Pa=self.p_max, speed_m_s=self._reference_kiss_speed())
+
+    def _reference_kiss_speed(self):
+        """Piston speed at the kiss point of the reference run [m/s] (1 without a fill phase)."""
+        impact = [e for e in self.reference_run.result.events if e.name == "impact"]
+        if not impact:
+            return 1.0
+        return max(abs(impact[0].x_before["v0"]), 1e-6)
 
     def _slip_rate(self):
         """d w_rel / dt in the slip mode (SX of the full state)."""
@@ -277,16 +350,21 @@ class EngagementOCP:
         w_in, w_out = self.model.speeds()
         return ca.jtimes(w_in - w_out, self.model.x, ca.vertcat(*mode.ode))
 
-    def _build_functions(self):
-        """Scaled dynamics, objective and end conditions, and the physical outputs (SX functions)."""
-        model, mode, sc = self.model, self.model.modes[SLIP_MODE], self.scales
+    def _build_functions(self, mode_name=SLIP_MODE, role="slip"):
+        """Scaled dynamics, objective and end conditions, and the physical outputs of one phase.
+
+        Returns
+        -------
+        dict
+            ``dynamics_fn (xs, us, weights) -> (xdot, q, c)``, ``objective_fn (xs, us, Q, T, weights)``,
+            ``end_fn (xs, us, T, weights)``, ``outputs_fn (xs, us)``, ``jump_fn (xs, us)``, ``subs``
+            (physical SX of the model state -> SX of the scaled NLP state) and ``output_names``.
+        """
+        model, mode, sc = self.model, self.model.modes[mode_name], self.scales
         n = len(self._phys)
         xs = ca.SX.sym("xs", n + 1)                 # physical states, then the dissipated energy
         us = ca.SX.sym("us")
-        x_full = ca.SX.zeros(len(model.state_names))
-        for k, name in enumerate(self._names):
-            for member in self.state_groups[name]:
-                x_full[model.index[member]] = xs[k] * self.nominal[k]
+        x_full = self._full_state(xs)
         u = us * sc.pressure_Pa
         ode = ca.vertcat(*mode.ode)
         w_in, w_out = model.speeds()
@@ -307,6 +385,13 @@ class EngagementOCP:
         }
         for i in range(model.n):
             physical[f"h_{i + 1}_m"] = mode.outputs[f"h_{i + 1}_m"]
+        if model.has_piston:
+            axial = mode_name.split("_")[0]
+            x0 = model.piston_position(axial)
+            physical["piston_position_m"] = x0
+            physical["piston_speed_m_s"] = model.state("v0")
+            physical["spring_force_N"] = model.drive_force(0.0, x0)       # Bao Eq. 21 at p = 0 (signed)
+            physical["pack_force_N"] = mode.outputs["pack_force_N"]
         physical.update({k: mode.outputs[k] for k in ("interface_heat_power_W", "interface_temperature_C")
                          if k in mode.outputs})
         physical = {k: ca.SX(v) for k, v in physical.items()}
@@ -317,52 +402,147 @@ class EngagementOCP:
             # cse merges the copies of equal films (and other repeated subexpressions)
             return ca.cse(ca.substitute(expr, ca.vertcat(model.x, self.u), ca.vertcat(x_full, u)))
 
-        self.output_names = list(physical)
-        self.outputs_fn = ca.Function("outputs", [xs, us], [subs(ca.vertcat(*physical.values()))])
+        # The jerk that is felt: the output's, or with the output held (a brake) the input's.
+        felt_jerk = physical["slip_jerk_rad_s3"] if self.output_held else physical["output_jerk_rad_s3"]
         t_ref = sc.time_s
         xdot = ca.vertcat(subs(ode[self._phys]) / self.nominal,
                           subs(physical["dissipated_power_W"]) / sc.energy_J) * t_ref
-        q = ca.vertcat(subs(physical["output_jerk_rad_s3"]) ** 2 * t_ref / sc.jerk_integral,
+        q = ca.vertcat(subs(felt_jerk) ** 2 * t_ref / sc.jerk_integral,
                        (subs(physical["pressure_rate_Pa_s"]) * t_ref / sc.pressure_Pa) ** 2)
         w_scale = max(self.scene.value("driveline.input_speed"), self.scene.get("driveline.output_speed", 0.0), 1.0)
         slip = subs(w_rel) / w_scale
+        c = slip if self.jerk_max is None else ca.vertcat(slip, subs(felt_jerk) / self.jerk_max)
+        c = ca.vertcat(c, *[subs(physical[name]) / limit for name, limit in self.heat_limits])
         weights = ca.SX.sym("weights", len(OBJECTIVE_TERMS))
-        path = ca.vertcat(slip, *[subs(physical[name]) / limit for name, limit in self.heat_limits])
-        self.dynamics_fn = ca.Function("dynamics", [xs, us, weights], [xdot, q, path])
-        # Objective and end conditions (w_rel = 0, jump = 0 unless penalised, energy <= E_max).
+        w = dict(zip(OBJECTIVE_TERMS, ca.vertsplit(weights)))
+        out = {"output_names": list(physical), "subs": subs,
+               "outputs_fn": ca.Function("outputs", [xs, us], [subs(ca.vertcat(*physical.values()))]),
+               "dynamics_fn": ca.Function("dynamics", [xs, us, weights], [xdot, q, c])}
         Q = ca.SX.sym("Q", 2)
         T = ca.SX.sym("T")
         locked, slipping = subs(physical["locked_torque_Nm"]), subs(physical["total_torque_Nm"])
         jump = (locked - slipping) / sc.torque_Nm
-        jump_condition = (locked * (1 + self.lock_margin) - slipping) / sc.torque_Nm
-        w = dict(zip(OBJECTIVE_TERMS, ca.vertsplit(weights)))
+        if role == "fill":
+            # Fill phase: ends at the kiss point x0 = travel; its own terms are its time and kiss speed.
+            kiss = subs(physical["piston_speed_m_s"]) / sc.speed_m_s
+            J = (w["jerk"] * Q[0] + w["smooth"] * Q[1] + (w["time"] + w["fill_time"]) * T
+                 + w["kiss_speed"] * kiss**2)
+            out["objective_fn"] = ca.Function("objective", [xs, us, Q, T, weights], [J])
+            i_x0 = self._names.index("x0")
+            g_end = [xs[i_x0] - self.model.travel / self.nominal[i_x0]]
+            if self.jerk_max is not None:     # the jerk just after the kiss (slip mode, after the reset)
+                g_end.append(self.kiss_jerk_fn(xs, us) / self.jerk_max)
+            out["end_fn"] = ca.Function("end", [xs, us, T, weights], [ca.vertcat(*g_end)])
+            out["jump_fn"] = ca.Function("jump", [xs, us], [jump * sc.torque_Nm])
+            return out
+        if self.holds_torque:
+            jump_condition = (locked * (1 + self.lock_margin) - slipping) / sc.torque_Nm
+        else:   # a lock that carries nothing: a small slipping torque left, so the slip still falls at t_f
+            jump_condition = (self.lock_margin * sc.torque_Nm - slipping) / sc.torque_Nm
         J = w["jerk"] * Q[0] + w["energy"] * xs[n] + w["time"] * T + w["jump"] * jump**2 + w["smooth"] * Q[1]
-        self.objective_fn = ca.Function("objective", [xs, us, Q, T, weights], [J])
+        out["objective_fn"] = ca.Function("objective", [xs, us, Q, T, weights], [J])
         # The lock must hold: the static capacity (about the slipping torque at lock-up) may not be
         # falling at t_f. Without this row the optimum lets the pressure fall through lock-up.
         capacity_rate = subs(physical["capacity_rate_Nm_s"]) * t_ref / sc.torque_Nm
-        g_end = [slip] + ([jump_condition] if self.jump_mode == "constraint" else []) + [capacity_rate, xs[n]]
-        self.end_fn = ca.Function("end", [xs, us, T, weights], [ca.vertcat(*g_end)])
-        self.jump_fn = ca.Function("jump", [xs, us], [jump * sc.torque_Nm])
+        g_end = [slip] + ([jump_condition] if self.jump_mode == "constraint" else []) \
+            + ([capacity_rate] if self.holds_torque else []) + [xs[n]]
+        out["end_fn"] = ca.Function("end", [xs, us, T, weights], [ca.vertcat(*g_end)])
+        out["jump_fn"] = ca.Function("jump", [xs, us], [jump * sc.torque_Nm])
+        return out
 
-    def _staged_problem(self):
+    def _full_state(self, xs):
+        """The model state (SX, SI) from the scaled NLP state ``xs`` (equal films copied)."""
+        x_full = ca.SX.zeros(len(self.model.state_names))
+        for k, name in enumerate(self._names):
+            for member in self.state_groups[name]:
+                x_full[self.model.index[member]] = xs[k] * self.nominal[k]
+        return x_full
+
+    def _staged_problem(self, role="slip"):
+        """The scaled problem of one phase (``x0`` given for the first phase only)."""
         n = len(self._phys)
+        fns = self.phase_functions[role]
+        first = self.phase_modes[0][0] == role
         x_lb, x_ub = np.full(n + 1, -np.inf), np.full(n + 1, np.inf)
         for i, name in enumerate(self._names):
             if name.startswith("h_"):
                 x_lb[i] = (self.h_min or 0.0) / self.nominal[i]
-        n_end = 3 + (self.jump_mode == "constraint")
-        end_lb, end_ub = np.zeros(n_end), np.zeros(n_end)
-        end_ub[-2] = np.inf                                          # capacity rate >= 0
-        end_lb[-1], end_ub[-1] = -np.inf, np.inf                     # energy row: set per solve
+        if role == "fill":
+            # The model has no piston stop. A spring-applied piston may not move back by more than
+            # 10 % of its stroke: without a bound the bao2020 optimum drew it back against its spring
+            # with the pressure and let it go, a 20 m/s kiss. A pressure-applied piston gets no bound:
+            # its optimum does not move back, and an inactive bound (at 1 or 10 % of the stroke)
+            # made IPOPT take 262 or 111 iterations instead of 47 on default_fill.
+            if self.apply_pressure == 0.0:
+                i_x0 = self._names.index("x0")
+                x_lb[i_x0] = -0.1 * self.model.travel / self.nominal[i_x0]
+            end_lb, end_ub = np.zeros(1), np.zeros(1)
+            if self.jerk_max is not None:
+                end_lb, end_ub = np.array([0.0, -1.0]), np.array([0.0, 1.0])
+        else:
+            n_end = 2 + (self.jump_mode == "constraint") + self.holds_torque
+            end_lb, end_ub = np.zeros(n_end), np.zeros(n_end)
+            if self.holds_torque:
+                end_ub[-2] = np.inf                                  # capacity rate >= 0
+            end_lb[-1], end_ub[-1] = -np.inf, np.inf                 # energy row: set per solve
+        c_lb, c_ub = np.array([0.0]), np.array([np.inf])
+        if self.jerk_max is not None:
+            c_lb, c_ub = np.array([0.0, -1.0]), np.array([np.inf, 1.0])
+        c_lb = np.append(c_lb, [-np.inf] * len(self.heat_limits))      # heat limits: value / limit <= 1
+        c_ub = np.append(c_ub, [1.0] * len(self.heat_limits))
         p0 = self.scene.value("actuation.initial_pressure") / self.scales.pressure_Pa
-        return StagedProblem(self.dynamics_fn, np.append(self.x0 / self.nominal, 0.0), self.objective_fn,
-                             self.end_fn, x_lb, x_ub, np.array([0.0]), np.array([1.0]),
-                             np.array([0.0] + [-np.inf] * len(self.heat_limits)),
-                             np.array([np.inf] + [1.0] * len(self.heat_limits)), end_lb, end_ub,
-                             u_rate=np.array([self.rate_limit * self.scales.time_s / self.scales.pressure_Pa])
-                             if np.isfinite(self.rate_limit) else None,
-                             u_initial=np.array([p0]))
+        u_rate = np.array([self.rate_limit * self.scales.time_s / self.scales.pressure_Pa]) \
+            if np.isfinite(self.rate_limit) else None
+        return StagedProblem(fns["dynamics_fn"], np.append(self.x0 / self.nominal, 0.0) if first else None,
+                             fns["objective_fn"], fns["end_fn"], x_lb, x_ub, np.array([0.0]), np.array([1.0]),
+                             c_lb, c_ub, end_lb, end_ub, u_rate=u_rate,
+                             u_initial=np.array([p0]) if first else None)
+
+    def _phased_nlp(self):
+        """The phases and their links (the impact reset between fill and slip)."""
+        phases = []
+        for name, mode in self.phase_modes:
+            tr = self.fill_transcription if name == "fill" else self.transcription
+            phases.append(Phase(name, mode, self._staged_problem(name), tr))
+        links = [self.impact_link()] if len(phases) > 1 else []
+        return PhasedNLP(phases, links)
+
+    def impact_reset(self):
+        """The impact reset map on the scaled NLP state: ``(xs_before) -> xs_after`` (casadi.Function).
+
+        It is the simulator's own map (the ``impact`` event of the fill mode: Bao Eq. 22 with plate
+        masses, the identity with a massless pack); the impact's kinetic-energy loss is added to the
+        dissipated-energy state.
+        """
+        n = len(self._phys)
+        xs = ca.SX.sym("xs", n + 1)
+        event = next(e for e in self.model.modes[FILL_MODE].events if e.name == "impact")
+        x_full = self._full_state(xs)
+
+        def subs(expr):
+            return ca.substitute(ca.SX(expr), self.model.x, x_full)
+
+        reset = event.reset or {}
+        after = []
+        for k, name in enumerate(self._names):
+            after.append(subs(reset[name]) / self.nominal[k] if name in reset else xs[k])
+        loss = subs(reset["E_impact"] - self.model.state("E_impact")) if "E_impact" in reset else 0.0
+        after.append(xs[n] + loss / self.scales.energy_J)
+        return ca.Function("impact_reset", [xs], [ca.vertcat(*after)])
+
+    def _kiss_jerk_fn(self):
+        """The felt jerk just after the kiss [rad/s^3]: the slip mode's, at the impact-reset state."""
+        n = len(self._phys)
+        xs, us = ca.SX.sym("xs", n + 1), ca.SX.sym("us")
+        slip = self.phase_functions["slip"]
+        index = slip["output_names"].index("slip_jerk_rad_s3" if self.output_held else "output_jerk_rad_s3")
+        return ca.Function("kiss_jerk", [xs, us], [slip["outputs_fn"](self.impact_reset()(xs), us)[index]])
+
+    def impact_link(self):
+        """Link residual of the fill -> slip junction: ``(x_end, x_start) -> x_start - reset(x_end)``."""
+        n = len(self._phys)
+        x_end, x_start = ca.MX.sym("x_end", n + 1), ca.MX.sym("x_start", n + 1)
+        return ca.Function("impact_link", [x_end, x_start], [x_start - self.impact_reset()(x_end)])
 
     # -- solving --------------------------------------------------------------------------------
     def solver(self, warm=False):
@@ -370,8 +550,8 @@ class EngagementOCP:
         key = "warm" if warm else "cold"
         if key not in self._solvers:
             if self._derivatives is None:
-                self._derivatives = structured_derivatives(self.nlp)
-            self._solvers[key] = nlp_solver(self.nlp, warm=warm, name=f"engagement_{key}",
+                self._derivatives = phased_derivatives(self.phased)
+            self._solvers[key] = nlp_solver(self.phased, warm=warm, name=f"engagement_{key}",
                                             derivatives=self._derivatives)
         return self._solvers[key]
 
@@ -439,8 +619,9 @@ class EngagementOCP:
     def _solve_stage(self, t_max, e_max, weights, guess):
         """One IPOPT solve of this problem (no polish)."""
         from .guess import guess_from_optimum, guess_from_run
-        nlp, sc = self.nlp, self.scales
-        warm = isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size
+        nlp, sc = self.phased, self.scales
+        warm = isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size \
+            and guess.lam_g.size == nlp.lbg.size
         if warm:
             w0, lam_x0, lam_g0 = guess.w.copy(), guess.lam_x, guess.lam_g
         else:
@@ -451,11 +632,15 @@ class EngagementOCP:
             lam_x0, lam_g0 = np.zeros_like(w0), np.zeros(nlp.lbg.size)
         lbx, ubx = nlp.lbx.copy(), nlp.ubx.copy()
         t_upper = min(t_max, 20.0 * sc.time_s)
-        lbx[nlp.t_slice] = 1e-3 * t_upper / sc.time_s
-        ubx[nlp.t_slice] = t_upper / sc.time_s
-        w0[nlp.t_slice] = np.clip(w0[nlp.t_slice], lbx[nlp.t_slice], ubx[nlp.t_slice])
+        for k, (name, _) in enumerate(self.phase_modes):
+            t_slice = nlp.t_slice(k)
+            # a fill phase may be a hundredth of the engagement: its lower bound is ten times smaller
+            lbx[t_slice] = (1e-3 if name == "slip" else 1e-4) * t_upper / sc.time_s
+            ubx[t_slice] = t_upper / sc.time_s
+            w0[t_slice] = np.clip(w0[t_slice], lbx[t_slice], ubx[t_slice])
         lbg, ubg = nlp.lbg.copy(), nlp.ubg.copy()
-        ubg[nlp.end_rows.stop - 1] = e_max / sc.energy_J if e_max is not None else np.inf
+        ubg[nlp.rows["total_time"]] = t_upper / sc.time_s
+        ubg[nlp.end_rows(len(nlp.parts) - 1).stop - 1] = e_max / sc.energy_J if e_max is not None else np.inf
         p = [weights[k] for k in OBJECTIVE_TERMS]
         solver = self.solver(warm)
         start = time.perf_counter()
@@ -477,7 +662,7 @@ class EngagementOCP:
                  f"{stats['iterations']} iterations")
         if status == "Infeasible_Problem_Detected":
             hint = (f"no command within the pressure and rate limits locks up by t_max with the end conditions "
-                    f"(the fastest lock-up, a step to the pressure limit, takes {self.fastest_lockup():.4g} s); "
+                    f"(the fastest lock-up, a step to {self._apply_label()}, takes {self.fastest_lockup():.4g} s); "
                     f"raise t_max, e_max or the limits")
         elif status == "Maximum_Iterations_Exceeded":
             hint = "start from a nearby solution (warm start) or use fewer intervals"
@@ -486,8 +671,65 @@ class EngagementOCP:
         return f"optimal engagement: IPOPT stopped with {status} ({where}); {hint}"
 
     def _result(self, w, lam_x, lam_g, objective, weights, stats):
-        parts = self.nlp.unpack(w)
-        sc, tr = self.scales, self.transcription
+        sc = self.scales
+        t_offset, pieces, phases = 0.0, [], []
+        for k, (part, (name, mode)) in enumerate(zip(self.phased.parts, self.phase_modes)):
+            piece = self._phase_result(part, self.phase_functions[name], part.unpack(self.phased.w_of(w, k)), t_offset)
+            phases.append({"name": name, "mode": mode, "t_start_s": t_offset, "t_end_s": t_offset + piece["T"],
+                           "intervals": part.transcription.intervals})
+            pieces.append(piece)
+            t_offset += piece["T"]
+        last, tr = pieces[-1], self.phased.parts[-1]
+        n_nodes = 0
+        for phase, piece in zip(phases, pieces):
+            phase["nodes"] = [n_nodes, n_nodes + piece["t"].size]
+            n_nodes += piece["t"].size
+
+        def cat(key, sub=None):
+            return np.concatenate([piece[key][sub] if sub else piece[key] for piece in pieces])
+
+        t = cat("t")
+        t_points = np.concatenate([piece["t_points"] for piece in pieces])
+        # the command is continuous across a link: its first value in a later phase is dropped
+        command_times = np.concatenate([pieces[0]["command_times"]] + [p["command_times"][1:] for p in pieces[1:]]) \
+            if tr.transcription.control == "linear" else cat("command_times")
+        command = np.concatenate([pieces[0]["command"]] + [p["command"][1:] for p in pieces[1:]]) \
+            if tr.transcription.control == "linear" else cat("command")
+        outputs = {key: np.concatenate([p["outputs"][key] for p in pieces]) for key in last["outputs"]}
+        outputs_points = {key: np.concatenate([p["outputs_points"][key] for p in pieces])
+                          for key in last["outputs_points"]}
+        states = {key: np.concatenate([p["states"][key] for p in pieces]) for key in last["states"]}
+        T = t_offset
+        felt = "slip_jerk_rad_s3" if self.output_held else "output_jerk_rad_s3"
+        xf, uf = last["x"][-1], last["u"][-1]
+        terms = {
+            "jerk_integral": sum(p["integrals"][felt] for p in pieces),
+            "slip_jerk_integral": sum(p["integrals"]["slip_jerk_rad_s3"] for p in pieces),
+            "dissipated_energy_J": float(xf[-1] * sc.energy_J),
+            "engagement_time_s": T,
+            "lockup_torque_jump_Nm": float(self.jump_fn(xf, uf)),
+            "final_slip_rad_s": float(outputs["w_rel_rad_s"][-1]),
+            "locked_torque_Nm": float(outputs["locked_torque_Nm"][-1]) if self.holds_torque else 0.0,
+            "peak_jerk_rad_s3": float(np.max(np.abs(outputs_points[felt]))),
+            "peak_torque_Nm": float(np.max(np.abs(outputs_points["total_torque_Nm"]))),
+            "objective": objective,
+        }
+        if len(pieces) > 1:
+            fill = pieces[0]
+            terms["fill_time_s"] = fill["T"]
+            terms["kiss_speed_m_s"] = float(fill["outputs"]["piston_speed_m_s"][-1])
+            # the jerk just after the kiss (at the slip phase's first node, which no collocation point sees)
+            terms["kiss_jerk_rad_s3"] = float(last["outputs"][felt][0]) if len(pieces) == 2 else None
+            terms["peak_jerk_rad_s3"] = max(terms["peak_jerk_rad_s3"], abs(terms["kiss_jerk_rad_s3"]))
+        if "interface_temperature_C" in outputs:
+            terms["peak_interface_temperature_C"] = float(max(outputs["interface_temperature_C"].max(),
+                                                              outputs_points["interface_temperature_C"].max()))
+        return OptimalEngagement(T, t, t_points, command_times, command, tr.transcription.control, states, outputs,
+                                 outputs_points, terms, objective, stats, w, lam_x, lam_g, weights, phases=phases)
+
+    def _phase_result(self, part, fns, parts, t_offset):
+        """Times, command, states and outputs of one phase (physical units, times from t_offset)."""
+        sc, tr = self.scales, part.transcription
         T = parts["T"] * sc.time_s
         starts, points = tr.node_times(T)
         x_nodes = parts["x"][:, :-1] * self.nominal
@@ -497,57 +739,60 @@ class EngagementOCP:
         command_times = starts[:n_u] if tr.control == "constant" else starts
         # Outputs at the nodes use the command of the interval they start (the last node: the last value).
         u_nodes = np.concatenate([u_values, u_values[-1:]]) if tr.control == "constant" else u_values
-        outputs = self._evaluate(parts["x"], u_nodes / sc.pressure_Pa)
+        outputs = self._evaluate(parts["x"], u_nodes / sc.pressure_Pa, fns)
         outputs["dissipated_energy_J"] = parts["x"][:, -1] * sc.energy_J
         xc = parts["xc"].reshape(-1, parts["xc"].shape[-1])
         uc = np.array(tr.control_at_points(ca.DM(parts["u"].T))).ravel()
-        outputs_points = {k: v.reshape(points.shape) for k, v in self._evaluate(xc, uc).items()}
+        outputs_points = {k: v.reshape(points.shape) for k, v in self._evaluate(xc, uc, fns).items()}
         quad = tr.B[None, :] * (T / tr.intervals)
-        terms = {
-            "jerk_integral": float(np.sum(quad * outputs_points["output_jerk_rad_s3"] ** 2)),
-            "slip_jerk_integral": float(np.sum(quad * outputs_points["slip_jerk_rad_s3"] ** 2)),
-            "dissipated_energy_J": float(parts["x"][-1, -1] * sc.energy_J),
-            "engagement_time_s": T,
-            "lockup_torque_jump_Nm": float(self.jump_fn(parts["x"][-1], parts["u"][-1])),
-            "final_slip_rad_s": float(outputs["w_rel_rad_s"][-1]),
-            "locked_torque_Nm": float(outputs["locked_torque_Nm"][-1]),
-            "peak_jerk_rad_s3": float(np.max(np.abs(outputs_points["output_jerk_rad_s3"]))),
-            "peak_torque_Nm": float(np.max(np.abs(outputs_points["total_torque_Nm"]))),
-            "objective": objective,
-        }
-        if "interface_temperature_C" in outputs:
-            terms["peak_interface_temperature_C"] = float(max(outputs["interface_temperature_C"].max(),
-                                                              outputs_points["interface_temperature_C"].max()))
+        integrals = {key: float(np.sum(quad * outputs_points[key] ** 2))
+                     for key in ("output_jerk_rad_s3", "slip_jerk_rad_s3")}
         states = {member: x_nodes[:, i] for i, name in enumerate(self._names) for member in self.state_groups[name]}
-        return OptimalEngagement(T, starts, points, command_times, u_values, tr.control, states, outputs,
-                                 outputs_points, terms, objective, stats, w, lam_x, lam_g, weights)
+        return {"T": T, "t": t_offset + starts, "t_points": t_offset + points,
+                "command_times": t_offset + command_times, "command": u_values, "outputs": outputs,
+                "outputs_points": outputs_points, "states": states, "integrals": integrals,
+                "x": parts["x"], "u": parts["u"]}
 
-    def _evaluate(self, xs, us):
-        values = np.array(self.outputs_fn.map(len(us))(np.asarray(xs).T, np.asarray(us)[None, :]))
-        return {name: values[i] for i, name in enumerate(self.output_names)}
+    def _evaluate(self, xs, us, fns=None):
+        fns = fns or self.phase_functions["slip"]
+        values = np.array(fns["outputs_fn"].map(len(us))(np.asarray(xs).T, np.asarray(us)[None, :]))
+        return {name: values[i] for i, name in enumerate(fns["output_names"])}
 
     # -- feasibility ----------------------------------------------------------------------------
     def default_t_max(self):
         """The baseline's lock-up time (no slower than the scene's own profile), or 1.5 x the fastest
-        lock-up if the baseline does not lock up [s]."""
+        lock-up if the baseline does not lock up or is itself the fastest lock-up (bao2020: the spring
+        applies the clutch at once; no smooth lock-up can be as fast) [s]."""
         t_lock = self.baseline.summary["engagement_time_s"]
-        return t_lock if t_lock is not None else 1.5 * self.fastest_lockup()
+        if t_lock is None or t_lock <= 1.001 * self.fastest_lockup():
+            return 1.5 * self.fastest_lockup()
+        return t_lock
 
     def fastest_run(self):
-        """IDAS run of a step of the command to the pressure limit (cached)."""
+        """IDAS run of a step of the command to the pressure that applies the clutch hardest (cached):
+        the pressure limit, or zero for a spring-applied piston (the pressure releases it)."""
         if self._fastest is None:
             from .replay import simulate_command
             t_end = self.scene.value("simulation.t_end")
-            run = simulate_command(self.scene, [0.0], [self.p_max], t_end)
+            run = simulate_command(self.scene, [0.0], [self.apply_pressure], t_end)
             if run.summary["engagement_time_s"] is None:
-                raise ModelError(f"scene '{self.scene.name}': even a step to actuation.max_pressure = "
-                                 f"{self.p_max / 1e6:.3g} MPa does not lock up within simulation.t_end = "
-                                 f"{t_end:g} s; raise the pressure limit or t_end")
+                raise ModelError(f"scene '{self.scene.name}': even a step to {self._apply_label()} does not lock "
+                                 f"up within simulation.t_end = {t_end:g} s; raise the pressure limit or t_end")
             self._fastest = run
         return self._fastest
 
+    @property
+    def apply_pressure(self):
+        """Command that applies the clutch hardest [Pa]: 0 for a spring-applied piston, else the limit."""
+        spring_applied = self.model.has_piston and self.scene.variant("piston") == "spring_applied"
+        return 0.0 if spring_applied else self.p_max
+
+    def _apply_label(self):
+        return "zero pressure (spring-applied)" if self.apply_pressure == 0.0 else \
+            f"actuation.max_pressure = {self.p_max / 1e6:.3g} MPa"
+
     def fastest_lockup(self):
-        """Lock-up time [s] of a step to the pressure limit (no profile under the limit locks sooner)."""
+        """Lock-up time [s] of a step to :attr:`apply_pressure` (no command within the limits locks sooner)."""
         return self.fastest_run().summary["engagement_time_s"]
 
     def check_feasible_time(self, t_max):
@@ -557,5 +802,5 @@ class EngagementOCP:
         fastest = self.fastest_lockup()
         if t_max < fastest:
             raise ModelError(f"t_max = {t_max:.4g} s is below the fastest lock-up the pressure limit allows "
-                             f"({fastest:.4g} s with a step to actuation.max_pressure = {self.p_max / 1e6:.3g} MPa); "
+                             f"({fastest:.4g} s with a step to {self._apply_label()}); "
                              f"raise t_max or the pressure limit")

@@ -9,7 +9,7 @@ from ..engagement.report import plot_heat
 from ..errors import ClutchocpError, ModelError
 from ..output import new_figure, save_figure, shown, write_csv, write_summary, writes_folder
 from ..scene import default_scene, load_scene
-from .baselines import baseline_label, simulate_baselines
+from .baselines import baseline_label, simulate_baselines, tune_fill_pulse
 from .outcome import OptimizationResult
 from .bound import jerk_lower_bound
 from .heat import heat_check
@@ -19,6 +19,9 @@ from .verify import HOLD_DELAY, holding_pressure, run_numbers, verify
 
 KEYS = ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral", "dissipated_energy_J", "peak_jerk_rad_s3",
         "peak_torque_Nm")
+COMPARE_KEYS = KEYS + ("locked_torque_Nm", "kiss_time_s", "kiss_speed_m_s", "kiss_jerk_rad_s3")
+# Minimum engagement time (a little command smoothing keeps the command regular).
+FAST_WEIGHTS = {"jerk": 0.0, "time": 1.0, "smooth": 0.01}
 
 
 @writes_folder
@@ -67,6 +70,10 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     files += plot_optimum(out, scene, opt, replay, ocp.baseline, result.baselines, summary)
     files.append(plot_heat(replay, out / "heat.png", max_temperature_C=max_temperature_C,
                            max_specific_power_W_mm2=max_specific_power_W_mm2, what="the IDAS replay of the optimum"))
+    if ocp.model.has_piston:
+        files.append(plot_piston(out, scene, replay, ocp.baseline))
+    if result.fill is not None:
+        files.append(plot_fill_comparison(out, scene, result.fill))
     if "sweep" in summary:
         files.append(plot_pareto(out, scene, summary["sweep"], summary["initial_slip_rad_s"],
                                  summary["initial_slip_rate_rad_s2"], ocp))
@@ -104,6 +111,7 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
     check, replay = verify(verifier, opt, model=command_model)
     say(f"  IDAS re-simulation: lock-up {_fmt(check['idas']['engagement_time_s'], 's')}, "
         f"jump {_fmt(check['torque_jump_Nm'], 'N m')}")
+    fill = _fill_comparison(ocp, opt, check, command_model, intervals, degree, say) if len(opt.phases) > 1 else None
     baselines = simulate_baselines(scene)
     w_rel0, rate0 = ocp.initial_slip()
     bound = jerk_lower_bound(w_rel0, rate0, opt.t_f)
@@ -115,6 +123,7 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
         "baseline": dict(run_numbers(ocp.baseline), profile=baseline_label(scene)),
         "baselines": {name: numbers for name, (_, numbers) in baselines.items()},
         "verification": {k: check[k] for k in ("lock_time_rel_diff", "lock_time_resolution_s", "torque_jump_Nm",
+                                              "jump_reference_Nm",
                                               "torque_jump_rel", "passed", "holding_pressure_Pa", "collocation",
                                               "idas")},
         # the bound on the same basis as optimal.jerk_integral (output jerk; the slip jerk's bound
@@ -129,6 +138,8 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
                    "rate_limit_Pa_s": ocp.rate_limit if np.isfinite(ocp.rate_limit) else None,
                    "lock_margin": ocp.lock_margin},
         "weights": opt.weights,
+        "phases": [{k: ph[k] for k in ("name", "mode", "t_start_s", "t_end_s", "intervals")} for ph in opt.phases],
+        "lockup_definition": _lockup_definition(ocp),
         "solver": {"status": opt.stats["status"], "iterations": opt.stats["iterations"],
                    "wall_time_s": opt.stats["wall_time_s"], "build_time_s": build_time,
                    "intervals": intervals, "degree": degree, "scheme": ocp.transcription.scheme,
@@ -137,9 +148,64 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
                               for s in opt.stats["stages"]]},
     }
     summary["heat"] = heat_check(ocp, opt, replay)
+    if "fill_time_s" in opt.terms:
+        summary["optimal"].update(fill_time_s=opt.terms["fill_time_s"], kiss_speed_m_s=opt.terms["kiss_speed_m_s"])
     if sweep is not None:
         summary["sweep"] = sweep
-    return OptimizationResult(scene, summary, ocp, opt, replay, baselines)
+    if fill is not None:
+        summary["fill_comparison"] = fill["summary"]
+    return OptimizationResult(scene, summary, ocp, opt, replay, baselines, fill=fill)
+
+
+def _lockup_definition(ocp):
+    """How lock-up and its jump are defined for this scene (one line for summary.json)."""
+    if ocp.holds_torque:
+        return "lock-up: w_in = w_out; jump = locked torque - slipping torque at that instant"
+    side = "the input comes to rest (output held: a brake)" if ocp.output_held else "w_out reaches w_in"
+    return (f"lock-up: {side}; the locked clutch carries no torque, so the jump is the torque step at that "
+            f"instant (minus the slipping torque before it), measured against the peak slipping torque")
+
+
+def _fill_comparison(ocp, opt, check, command_model, intervals, degree, say):
+    """The minimum-time optimum against the tuned "fill pulse, hold, ramp" at equal peak jerk.
+
+    The baseline is tuned (:func:`tune_fill_pulse`) to lock up soonest with its peak jerk (the jerk
+    just after the kiss included) within the peak jerk of the main optimum's slip phase at its
+    collocation points and its lock-up jump within the verification tolerance;
+    the optimum is then re-solved for minimum engagement time with |jerk| <= the baseline's peak
+    jerk (warm start from the main optimum) and verified with IDAS.
+    """
+    felt = "slip_jerk_rad_s3" if ocp.output_held else "output_jerk_rad_s3"
+    first_slip_interval = sum(ph["intervals"] for ph in opt.phases[:-1])
+    cap = float(np.max(np.abs(opt.outputs_points[felt][first_slip_interval:])))
+    say(f"  fill-pulse baseline: tuning for the shortest lock-up with peak jerk <= {cap:.4g} rad/s^3 "
+        f"(the main optimum's slip-phase peak; the jerk just after the kiss included)")
+    tuned = tune_fill_pulse(ocp.scene, jerk_cap=cap, p_max=ocp.p_max, rate_limit=ocp.rate_limit,
+                            t_scale=ocp.scales.time_s, progress=say)
+    base = tuned["numbers"]
+    # 0.1 % below the baseline's peak: IDAS samples between the collocation points see a little more
+    jerk_max = 0.999 * min(base["peak_jerk_rad_s3"] or cap, cap)
+    fast_ocp = EngagementOCP(ocp.scene, intervals=intervals, degree=degree, jerk_max=jerk_max, baseline=ocp.baseline)
+    say(f"  minimum-time optimum with |jerk| <= {jerk_max:.4g} rad/s^3")
+    fast = fast_ocp.solve(weights=FAST_WEIGHTS, guess=opt)
+    fast_check, fast_run = verify(fast_ocp.exact, fast, model=command_model)
+    numbers = fast_check["idas"]
+    summary = {
+        "jerk_cap_rad_s3": jerk_max,
+        "weights": fast.weights,
+        "optimal": {k: numbers[k] for k in COMPARE_KEYS},
+        "optimal_verification_passed": fast_check["passed"],
+        "baseline": {k: base[k] for k in COMPARE_KEYS},
+        "baseline_parameters": tuned["parameters"],
+        "baseline_evaluations": tuned["evaluations"],
+        "optimal_faster": bool(base["engagement_time_s"] is None
+                               or numbers["engagement_time_s"] < base["engagement_time_s"]),
+    }
+    say(f"  minimum time: {_fmt(numbers['engagement_time_s'], 's')} "
+        f"(kiss speed {_fmt(numbers['kiss_speed_m_s'], 'm/s')}) "
+        f"against the tuned fill pulse {_fmt(base['engagement_time_s'], 's')} "
+        f"(kiss speed {_fmt(base['kiss_speed_m_s'], 'm/s')})")
+    return {"summary": summary, "optimal_run": fast_run, "baseline_run": tuned["run"], "baseline": tuned}
 
 
 def _fmt(value, unit, fmt="{:.4g}"):
@@ -290,6 +356,68 @@ def plot_baselines(out, name, summary, baselines, bound_at):
             title=f"{name}: jerk against engagement time")
     ax2.grid(alpha=0.3, which="both")
     return save_figure(fig, out / "baselines.png")
+
+
+def plot_piston(out, scene, replay, baseline):
+    """Piston travel, speed and spring force of the optimum (IDAS replay) and the scene's own profile."""
+    fig, (ax1, ax2) = new_figure(2, width=4.8)
+    runs = (("optimal (IDAS replay)", replay, "C0"), ("scene profile", baseline, "C3"))
+    for label, run, color in runs:
+        res = run.result
+        ax1.plot(res.t * 1e3, res["x0"] * 1e3, color=color, label=f"{label}: travel")
+        ax2.plot(res.t * 1e3, _spring_force(run), color=color, label=f"{label}: spring")
+        ax2.plot(res.t * 1e3, res["pressure_Pa"] * scene.value("piston.area"), color=color, ls="--",
+                 label=f"{label}: pressure x area")
+        kiss = [e.t for e in res.events if e.name == "impact"]
+        for t in kiss:
+            ax1.axvline(t * 1e3, color=color, lw=0.8, ls=":")
+    t_end = 1.5 * max(run.summary["engagement_time_s"] or run.result.t[-1] for _, run, _ in runs)
+    travel = scene.get("piston.travel_to_pack", 0.0)
+    if travel > 0:
+        ax1.axhline(travel * 1e3, color="k", lw=0.8, ls=":", label="kiss point (pack reached)")
+    ax1.set(xlabel="time [ms]", ylabel="piston travel [mm]", title=f"{scene.name}: piston stroke",
+            xlim=(0, t_end * 1e3))
+    ax2.set(xlabel="time [ms]", ylabel="force [N]", title="spring force and hydraulic force", xlim=(0, t_end * 1e3))
+    ax1.legend(fontsize=7)
+    ax2.legend(fontsize=7)
+    return save_figure(fig, out / "piston.png")
+
+
+def _spring_force(run):
+    """|spring force| [N] along a run from the piston travel (Bao Eq. 21 springs)."""
+    s = run.model.scene
+    k = s.value("piston.spring_stiffness") * s.value("piston.spring_count")
+    sign = -1.0 if s.variant("piston") == "spring_applied" else 1.0
+    return k * (s.value("piston.spring_preload") + sign * run.result["x0"])
+
+
+def plot_fill_comparison(out, scene, fill):
+    """Pressure, torque and jerk of the minimum-time optimum against the tuned fill pulse (both IDAS)."""
+    fig, axes = new_figure(3, width=4.2)
+    cap = fill["summary"]["jerk_cap_rad_s3"]
+    runs = (("minimum-time optimum", fill["optimal_run"], "C0"),
+            ("tuned fill pulse, hold, ramp", fill["baseline_run"], "C3"))
+    for label, run, color in runs:
+        res = run.result
+        t_lock = run.summary["engagement_time_s"]
+        axes[0].plot(res.t, res["pressure_Pa"] / 1e6, color=color, label=label)
+        axes[1].plot(res.t, res["total_torque_Nm"], color=color, label=label)
+        mask = res.t <= (t_lock if t_lock is not None else res.t[-1])
+        axes[2].plot(res.t[mask], res["output_jerk_rad_s3"][mask], color=color, label=label)
+        for ax in axes:
+            if t_lock is not None:
+                ax.axvline(t_lock, color=color, lw=0.8, ls=":")
+    axes[2].axhline(cap, color="k", lw=0.8, ls="--", label="peak-jerk limit (both)")
+    times = [run.summary["engagement_time_s"] for _, run, _ in runs]
+    fig.suptitle(f"Minimum-time optimum against the tuned fill pulse at equal peak jerk ({cap:.4g} rad/s^3, both "
+                 f"IDAS): lock-up at {_fmt(times[0], 's')} against {_fmt(times[1], 's')}", fontsize=10)
+    axes[2].axhline(-cap, color="k", lw=0.8, ls="--")
+    t_end = 1.2 * max(run.summary["engagement_time_s"] or run.result.t[-1] for _, run, _ in runs)
+    for ax, ylabel, title in zip(axes, ("valve pressure [MPa]", "clutch torque [N m]", "output jerk [rad/s^3]"),
+                                 ("pressure", "torque (dotted: lock-up)", "jerk up to lock-up")):
+        ax.set(xlabel="time [s]", ylabel=ylabel, title=f"{scene.name}: {title}", xlim=(0, t_end))
+        ax.legend(fontsize=7)
+    return save_figure(fig, out / "fill_comparison.png")
 
 
 def _locks(ax, runs):

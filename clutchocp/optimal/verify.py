@@ -1,20 +1,24 @@
 """Verification of an optimum by IDAS, and the numbers of an IDAS engagement run.
 
-The optimal command is replayed on the exact (non-smoothed) model with IDAS and its lock-up
-events; just after the collocation lock time the command steps to the holding pressure (the larger
+The optimal command is replayed on the exact (non-smoothed) model with IDAS and its impact and
+lock-up events; just after the collocation lock time the command steps to the holding pressure (the larger
 of the last command and the scene's set pressure), as a transmission controller clamps a locked
 clutch. The collocation prediction and the IDAS run are then compared side by side.
+
+The lock-up jump is measured against the torque the locked clutch carries; where it carries none
+(a brake with its output held; a prescribed input speed without load) the jump is the torque step
+at the stop, measured against the peak slipping torque of the run.
 """
 
 import numpy as np
 
 from ..simulation import SimulationOptions
 from ..simulation.locate import root_near
-from .guess import DISSIPATED, slip_samples
+from .guess import DISSIPATED, engagement_samples
 from .replay import CommandModel, simulate_command
 
 LOCK_TIME_TOLERANCE = 0.01      # relative
-JUMP_TOLERANCE = 0.02           # relative to the torque carried after lock-up
+JUMP_TOLERANCE = 0.02           # relative to the torque carried after lock-up (or the peak torque, see above)
 HOLD_DELAY = 1e-3               # the holding command starts at (1 + HOLD_DELAY) t_f
 
 
@@ -24,20 +28,37 @@ def run_numbers(run):
     Returns
     -------
     dict
-        engagement_time_s, lockup_torque_jump_Nm, jerk_integral (int jerk^2 dt over the slip phase
-        [rad^2/s^5], trapezoidal on the output samples), peak_jerk_rad_s3, peak_torque_Nm,
-        dissipated_energy_J (at lock-up), locked_torque_Nm.
+        engagement_time_s, lockup_torque_jump_Nm, jerk_integral (int jerk^2 dt from t = 0 to
+        lock-up, fill and slip [rad^2/s^5], trapezoidal on the output samples), peak_jerk_rad_s3, peak_torque_Nm,
+        dissipated_energy_J (at lock-up), locked_torque_Nm, kiss_time_s and kiss_speed_m_s (the
+        impact of the piston on the pack; None without free travel), kiss_jerk_rad_s3 (the jerk just
+        after the kiss, part of the peak jerk). With the output held (a brake)
+        the jerk is the input's, -dT/dt / I_in by differences of the clutch torque.
     """
     summary = run.summary
     out = {"engagement_time_s": summary["engagement_time_s"], "lockup_torque_jump_Nm": summary["lockup_torque_jump_Nm"],
            "jerk_integral": None, "peak_jerk_rad_s3": None, "peak_torque_Nm": summary["peak_torque_Nm"],
-           "dissipated_energy_J": summary["dissipated_energy_J"], "locked_torque_Nm": None}
+           "dissipated_energy_J": summary["dissipated_energy_J"], "locked_torque_Nm": None,
+           "kiss_time_s": None, "kiss_speed_m_s": None, "kiss_jerk_rad_s3": None}
+    impact = [e for e in run.result.events if e.name == "impact"]
+    if impact:
+        out["kiss_time_s"], out["kiss_speed_m_s"] = float(impact[0].t), float(impact[0].x_before["v0"])
     if summary["engagement_time_s"] is None:
         return out
-    t, idx, _ = slip_samples(run)
-    jerk = run.result["output_jerk_rad_s3"][idx]
+    t, idx = engagement_samples(run)
+    model = run.model
+    if output_held(model):
+        jerk = -np.gradient(run.result["total_torque_Nm"][idx], t) / model.scene.value("driveline.input_inertia")
+    else:
+        jerk = run.result["output_jerk_rad_s3"][idx]
     out["jerk_integral"] = float(np.trapezoid(jerk**2, t))
     out["peak_jerk_rad_s3"] = float(np.max(np.abs(jerk)))
+    if impact and not output_held(model):
+        # the jerk just after the kiss: the sample of the pressing mode at the impact time
+        after = np.flatnonzero((run.result.t == impact[0].t) & (np.asarray(run.result.mode) == "pressing_slip_forward"))
+        out["kiss_jerk_rad_s3"] = float(run.result["output_jerk_rad_s3"][after[0]]) if after.size else None
+        if after.size:
+            out["peak_jerk_rad_s3"] = max(out["peak_jerk_rad_s3"], abs(out["kiss_jerk_rad_s3"]))
     out["peak_torque_Nm"] = float(np.max(np.abs(run.result["total_torque_Nm"][idx])))
     lock = next(e for e in run.result.events if e.name == "lockup" and e.target.endswith("locked"))
     out["dissipated_energy_J"] = float(sum(lock.x_before[name] for name in DISSIPATED if name in lock.x_before))
@@ -45,9 +66,22 @@ def run_numbers(run):
     return out
 
 
+def output_held(model):
+    """True for a brake: the output is held and the input is the braked inertia."""
+    return model.input_inertia and not model.output_inertia
+
+
+def jump_reference(ocp, numbers):
+    """Torque the lock-up jump is measured against [N m]: the locked torque, or for a lock that
+    carries none the peak slipping torque."""
+    return abs(numbers["locked_torque_Nm"]) if ocp.holds_torque else abs(numbers["peak_torque_Nm"])
+
+
 def holding_pressure(ocp, opt):
-    """Command after lock-up [Pa]: the larger of the last command and the scene's set pressure."""
-    return float(max(opt.command[-1], ocp.scene.value("actuation.pressure")))
+    """Command after lock-up [Pa]: the larger of the last command and the scene's set pressure (the
+    smaller for a spring-applied piston, where pressure releases the clutch)."""
+    pick = min if ocp.apply_pressure == 0.0 else max
+    return float(pick(opt.command[-1], ocp.scene.value("actuation.pressure")))
 
 
 def located_lock_time(run):
@@ -104,19 +138,22 @@ def verify(ocp, opt, *, model=None, rtol=None, atol=None):
     colloc = {k: opt.terms[k] for k in ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral",
                                         "peak_jerk_rad_s3", "peak_torque_Nm", "dissipated_energy_J",
                                         "locked_torque_Nm")}
+    colloc["kiss_time_s"], colloc["kiss_speed_m_s"] = opt.terms.get("fill_time_s"), opt.terms.get("kiss_speed_m_s")
+    colloc["kiss_jerk_rad_s3"] = opt.terms.get("kiss_jerk_rad_s3")
     # IDAS locates lock-up to |w_rel| / w_scale <= event_value_tol; at the final slip rate that is:
     w_scale = max(ocp.scene.value("driveline.input_speed"), 1.0)
     rate = abs(opt.outputs["slip_acceleration_rad_s2"][-1])
     resolution = SimulationOptions().event_value_tol * w_scale / rate if rate > 0 else None
     out = {"collocation": colloc, "idas": idas, "holding_pressure_Pa": hold[1], "lock_time_resolution_s": resolution,
            "lock_time_rel_diff": None, "torque_jump_Nm": idas["lockup_torque_jump_Nm"],
-           "torque_jump_rel": None, "passed": False}
+           "torque_jump_rel": None, "jump_reference_Nm": None, "passed": False}
     if idas["engagement_time_s"] is not None:
         located = located_lock_time(run)
         idas["located_lock_time_s"] = located
         t_idas = located if located is not None else idas["engagement_time_s"]
         out["lock_time_rel_diff"] = abs(t_idas - t_f) / t_f
-        out["torque_jump_rel"] = abs(idas["lockup_torque_jump_Nm"]) / max(abs(idas["locked_torque_Nm"]), 1e-9)
+        out["jump_reference_Nm"] = jump_reference(ocp, idas)
+        out["torque_jump_rel"] = abs(idas["lockup_torque_jump_Nm"]) / max(out["jump_reference_Nm"], 1e-9)
         out["passed"] = bool(out["lock_time_rel_diff"] <= LOCK_TIME_TOLERANCE
                              and out["torque_jump_rel"] <= JUMP_TOLERANCE)
     return out, run

@@ -279,7 +279,11 @@ def main(argv=None):
                 f"{name}: warning: {' '.join(str(message).split())}", file=sys.stderr)
             args = build_parser().parse_args(argv)
             name = f"clutchocp {args.command}"
-            code = args.run(args)
+            try:
+                code = args.run(args)
+            except ClutchocpError:
+                interrupt.check()          # a solver failure that a Ctrl-C caused is an interrupt
+                raise
             interrupt.check()
             return code
     except SystemExit as exc:            # argparse: --help (0) or a bad option (2, already printed)

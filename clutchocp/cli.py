@@ -14,7 +14,6 @@ import math
 import os
 import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 
@@ -253,7 +252,7 @@ def build_parser():
                    help="solve for several engagement-time limits and draw the jerk/time trade-off")
     p.set_defaults(run=_cmd_optimize)
     p = sub.add_parser("bench", help="error against run time, stiffness and scaling (work-precision report)")
-    p.add_argument("--quick", action="store_true", help="fewer tolerances and sizes (under 3 minutes)")
+    p.add_argument("--quick", action="store_true", help="fewer tolerances, repeats and sizes, no native code (a few minutes)")
     p.add_argument("--out", default="out/bench", help="output folder (default: out/bench)")
     p.set_defaults(run=_cmd_bench)
     p = sub.add_parser("control", help="hydro-viscous drive: operating points, linearisation, speed controller, closed loop")

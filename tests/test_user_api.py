@@ -200,6 +200,16 @@ def test_baselines_figure_compares_at_the_engagement_time(best, monkeypatch, tmp
                for name in ("pressure.png", "torque.png", "jerk.png", "speeds.png"))
 
 
+def test_ctrl_c_during_a_sweep_stops_it_instead_of_dropping_the_point(best):
+    from clutchocp import interrupt
+    interrupt._state["requested"] = True           # as after a Ctrl-C that IPOPT swallowed
+    try:
+        with pytest.raises(interrupt.UserInterrupt, match="IPOPT"):
+            optimal_report._sweep(best.ocp, best.optimum, [0.25], None, lambda *a, **k: None)
+    finally:
+        interrupt._state["requested"] = False
+
+
 @pytest.mark.slow
 def test_a_time_objective_is_not_held_back_by_the_smooth_term():
     from clutchocp.optimal.problem import EngagementOCP

@@ -292,3 +292,10 @@ def test_the_suite_covers_over_100_kinds():
     kinds = (sum(1 for _ in _scene_cases()) + 3 + 1 + len(FLAG_CASES) + 15 + sum(1 for _ in _controller_cases())
              + 4 + 1)
     assert kinds >= 100, kinds
+
+
+def test_a_loose_tolerance_runs_with_one_warning_naming_it(tmp_path, capsys):
+    assert main(["simulate", "zhang2021", "--rtol", "1e-3", "--out", str(tmp_path / "out")]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "warning" in err[0] and "1e-3" in err[0]
+    assert (tmp_path / "out" / "summary.json").exists()

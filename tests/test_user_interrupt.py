@@ -123,3 +123,17 @@ def test_ipopt_stops_at_the_next_iteration_after_ctrl_c():
 def test_without_ctrl_c_the_solvers_run_as_before():
     run = simulate_engagement(load_scene("zhang2021"))
     assert run.summary["engagement_time_s"] is not None and np.isfinite(run.summary["dissipated_energy_J"])
+
+
+def test_a_solver_failure_caused_by_ctrl_c_is_reported_as_the_interrupt(monkeypatch, capsys):
+    from clutchocp import cli
+    from clutchocp.errors import SolverError
+
+    def failing(args):
+        interrupt._state["requested"] = True         # Ctrl-C inside a solver that turned it into a failure
+        raise SolverError("rootfinder failed")
+    monkeypatch.setattr(cli, "_cmd_scenes", failing)
+    assert cli.main(["scenes"]) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "interrupted by the user" in err[0] and "rootfinder" not in err[0]
+    assert not interrupt.requested()

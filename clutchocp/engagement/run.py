@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, SolverError
-from ..simulation.result import Table
+from ..simulation.result import Table, unit_of
 from ..simulation import SimulationOptions, simulate
 from ..simulation.locate import crossing_time, peak
 from ..scene import load_scene
@@ -48,8 +48,7 @@ class EngagementResult:
         """The time series as a :class:`~clutchocp.simulation.result.Table`: every column named with its
         unit (those of timeseries.csv without the unit-less state copies), samples on the output grid
         and at both sides of each event."""
-        return Table({name: values for name, values in self.series().items()
-                      if name == "mode" or Table({name: ()}).units[name]})
+        return Table({name: values for name, values in self.series().items() if name == "mode" or unit_of(name)})
 
     def plot(self, path=None):
         """Overview figure: films, speeds, torque and pressure against time; PNG if ``path`` is given.

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from .. import interrupt
 from ..errors import SolverError
 from .steady import rest_state
 
@@ -101,10 +102,12 @@ class SampledPlant:
         try:
             r = self.integrator(x0=self.xs, z0=self.zs, p=np.asarray(u, float))
         except RuntimeError as err:
+            interrupt.check(f"IDAS (closed loop) at t = {self.t:.6g} s")   # a Ctrl-C fails the step
             state = dict(zip(self.cm.x_names, self.x))
             raise SolverError(f"closed loop: IDAS failed between t = {self.t:.6g} s and {self.t + self.Ts:.6g} s "
                               f"with command {u[0]:.6g} Pa ({err}). State: {state}. Try: a longer valve time "
                               "constant or a smaller sample time") from None
+        interrupt.check(f"IDAS (closed loop) at t = {self.t:.6g} s")
         self.xs = np.array(r["xf"], float).ravel()
         self.zs = np.array(r["zf"], float).ravel()
         self.t += self.Ts

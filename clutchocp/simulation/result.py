@@ -109,19 +109,26 @@ def _short_repr(self):
 SimulationResult.__repr__ = _short_repr
 
 
+# column-name suffix -> unit (longest suffixes first)
+UNIT_SUFFIXES = (("_rad_s3", "rad/s^3"), ("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_m_s", "m/s"),
+                 ("_Nm", "N m"), ("_Pa", "Pa"), ("_N", "N"), ("_W", "W"), ("_J", "J"), ("_m", "m"), ("_s", "s"))
+
+
+def unit_of(name):
+    """The unit a column name ends with (``"total_torque_Nm"`` -> ``"N m"``), "" if none."""
+    return next((unit for suffix, unit in UNIT_SUFFIXES if name.endswith(suffix)), "")
+
+
 class Table(dict):
     """Columns of equal length, each named with its unit (``"time_s"``, ``"pressure_Pa"``, ``"mode"``).
 
     A dict ``{name: numpy array}`` with a short repr, :attr:`units` and :meth:`to_csv`.
     """
 
-    UNITS = (("_rad_s3", "rad/s^3"), ("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_m_s", "m/s"),
-             ("_Nm", "N m"), ("_Pa", "Pa"), ("_N", "N"), ("_W", "W"), ("_J", "J"), ("_m", "m"), ("_s", "s"))
-
     @property
     def units(self):
         """{column: unit} read off the name's suffix ("" for text columns such as ``mode``)."""
-        return {name: next((unit for suffix, unit in self.UNITS if name.endswith(suffix)), "") for name in self}
+        return {name: unit_of(name) for name in self}
 
     def to_csv(self, path):
         """Write the table as CSV (the header holds the names with their units); returns the path."""

@@ -97,7 +97,7 @@ def run_closed_loop(scene, feedback, t_end, *, nominal_scene=None, model=None, r
     t = 0.0
     while t < t_end - 1e-12:
         if mode.endswith("locked"):
-            u_now = feedback.feedforward(t) + (record["correction_Pa"][-1] if record["t"] else 0.0)
+            u_now = feedback.feedforward(t - feedback.shift) + (record["correction_Pa"][-1] if record["t"] else 0.0)
             c_times, c_values = post_lock_command(nominal_scene or scene, np.append(record["t"], t),
                                                   np.append(record["command_Pa"], u_now), t, feedback.rate_limit)
             handover = t
@@ -114,7 +114,7 @@ def run_closed_loop(scene, feedback, t_end, *, nominal_scene=None, model=None, r
         record["command_unsat_Pa"].append(u_unsat)
         record["integral_rad"].append(feedback.integral)
         t_next = min(t + Ts, t_end)
-        u = model.inputs(feedback.ff_times, feedback.ff_values + du)
+        u = model.inputs(feedback.ff_times + feedback.shift, feedback.ff_values + du)
         piece = simulate(model.hybrid, x, np.linspace(t, t_next, POINTS_PER_SAMPLE), mode=mode, u=u, options=options)
         segments += piece.segments
         events += piece.events

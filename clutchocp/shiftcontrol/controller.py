@@ -50,7 +50,7 @@ class SlipFeedback:
     """
 
     def __init__(self, sample_time, gains, integral_gains, reference, slip_reference, measured, feedforward,
-                 p_min, p_max, rate_limit, anti_windup="clamping"):
+                 p_min, p_max, rate_limit, anti_windup="clamping", path=None):
         self.Ts = float(sample_time)
         self.gains = np.atleast_2d(np.asarray(gains, float))
         self.integral_gains = np.asarray(integral_gains, float).ravel()
@@ -69,6 +69,7 @@ class SlipFeedback:
             raise ModelError(f"anti_windup = {anti_windup!r}: allowed values are clamping, none")
         self.anti_windup = anti_windup
         self.enabled = True
+        self.path = None if path is None else tuple(np.asarray(a, float) for a in path)
         self.reset()
 
     @property
@@ -79,6 +80,7 @@ class SlipFeedback:
     def reset(self):
         """Before a run: zero integral, no previous sample."""
         self.integral = 0.0
+        self.progress = 0.0
         self._previous_slip = None
         self._previous_command = None
 
@@ -86,11 +88,32 @@ class SlipFeedback:
         """Feedforward command at time t [Pa] (piecewise linear, the last value held)."""
         return float(np.interp(t, self.ff_times, self.ff_values))
 
-    def _reference(self, k):
-        j = min(k, self.horizon)
-        ref = self.reference[j].copy()
-        slip = self.slip_reference[j]
-        if k > self.horizon:                       # past the nominal lock-up: hold the locked state
+    def _progress(self, k, w_rel):
+        """Reference time tau [s] of sample k: t_k, or on the falling branch of the nominal slip the time
+        at which the nominal slip equals the measured one (never going back)."""
+        t = k * self.Ts
+        if self.path is None:
+            return t
+        t_path, w_path = self.path            # the falling branch: times increasing, slip decreasing
+        if t < t_path[0]:
+            return t
+        tau = float(np.interp(-w_rel, -w_path, t_path)) if w_rel < w_path[0] else t_path[0]
+        return max(tau, self.progress)
+
+    def _at(self, table, tau):
+        """Row of a per-sample table at reference time tau (linear between samples, ends held)."""
+        pos = min(max(tau / self.Ts, 0.0), table.shape[0] - 1.0)
+        j = min(int(pos), table.shape[0] - 2) if table.shape[0] > 1 else 0
+        if table.shape[0] == 1:
+            return table[0]
+        f = pos - j
+        return (1 - f) * table[j] + f * table[j + 1]
+
+    def _reference(self, tau):
+        ref = self._at(self.reference, tau)
+        slip = float(self._at(self.slip_reference[:, None], tau)[0])
+        if tau > self.horizon * self.Ts:           # past the nominal lock-up: hold the locked state
+            ref = ref.copy()
             ref[self.measured.index("slip_rate")] = 0.0
             slip = 0.0
         return ref, slip
@@ -103,9 +126,12 @@ class SlipFeedback:
         (du, u, u_unsat) : the held correction, the command at t_k and the command before the limits [Pa].
         """
         t = k * self.Ts
-        u_ff = self.feedforward(t)
+        self._last_t = t
         w_rel = signals["w_in"] - signals["w_out"]
-        ref, slip_ref = self._reference(k)
+        tau = self._progress(k, w_rel)
+        self.progress = tau
+        u_ff = self.feedforward(tau)
+        ref, slip_ref = self._reference(tau)
         rate = (w_rel - self._previous_slip) / self.Ts if self._previous_slip is not None else None
         y = []
         for j, name in enumerate(self.measured):
@@ -115,8 +141,8 @@ class SlipFeedback:
                 y.append(signals[name])
         dy = np.asarray(y) - ref
         e = w_rel - slip_ref
-        gain = self.gains[min(k, self.horizon - 1)]
-        k_xi = self.integral_gains[min(k, self.horizon - 1)]
+        gain = self._at(self.gains, min(tau, (self.horizon - 1) * self.Ts))
+        k_xi = float(self._at(self.integral_gains[:, None], min(tau, (self.horizon - 1) * self.Ts))[0])
         du_unsat = -float(gain @ dy) - k_xi * self.integral if self.enabled else 0.0
         u_unsat = u_ff + du_unsat
         u = min(max(u_unsat, self.p_min), self.p_max)
@@ -131,3 +157,8 @@ class SlipFeedback:
         self._previous_slip = w_rel
         self._previous_command = u
         return u - u_ff, u, u_unsat
+
+    @property
+    def shift(self):
+        """How far the feedforward is delayed at the last sample, t_k - tau_k [s] (0 without a path)."""
+        return self._last_t - self.progress

@@ -183,6 +183,12 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
         for j, name in enumerate(measured):
             if name in ("w_in", "w_out"):
                 ref[N, j] = lock.x_after[name]
+    path = None
+    if spec.progress == "slip":
+        w_slip = np.array([lin.signal_values(x, ff(t))["w_rel"] for t, x in zip(t_slip, x_slip)])
+        peak = int(np.argmax(w_slip))
+        fall = slice(peak, None)
+        path = (np.append(t_slip[fall], t_lock), np.append(w_slip[fall], 0.0))
     feedback = SlipFeedback(Ts, gains, K[:, 0, n], ref, slip_ref, measured, (times, values), p_lo, p_hi,
-                            (p_hi - p_lo) / spec.rate_limit_time, spec.anti_windup)
+                            (p_hi - p_lo) / spec.rate_limit_time, spec.anti_windup, path=path)
     return SlipFeedbackDesign(feedback, nominal, t_lock, sample_times, Phi, Gamma, K, P, lin.state_names, spec)

@@ -31,6 +31,7 @@ from ..scene.loader import _suggest, read_toml
 
 TYPES = ("slip_lqi",)
 ANTI_WINDUP = ("clamping", "none")
+PROGRESS = ("slip", "time")
 
 _CONTROLLER = {
     "name": ("str", None, ""),
@@ -41,6 +42,7 @@ _CONTROLLER = {
     "pressure_max": ("Pa", "positive", None),
     "rate_limit_time": ("s", "positive", 0.01),
     "measure_pressure": ("bool", None, True),
+    "progress": ("choice", PROGRESS, "slip"),
 }
 _LQI = {
     "slip_tolerance": ("1", "positive", 0.01),
@@ -65,6 +67,7 @@ class SlipControlSpec:
     pressure_max: float | None = None
     rate_limit_time: float = 0.01
     measure_pressure: bool = True
+    progress: str = "slip"
     lqi: dict = field(default_factory=lambda: {k: v[2] for k, v in _LQI.items()})
     anti_windup: str = "clamping"
     path: Path | None = None
@@ -115,4 +118,5 @@ def parse_slip_spec(raw):
     return SlipControlSpec(sample_time=c["sample_time"], name=c["name"], description=c["description"],
                            pressure_min=c["pressure_min"], pressure_max=c["pressure_max"],
                            rate_limit_time=c["rate_limit_time"], measure_pressure=c["measure_pressure"],
+                           progress=c["progress"],
                            lqi=weights, anti_windup=values["anti_windup"]["method"])

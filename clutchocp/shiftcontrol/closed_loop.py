@@ -39,6 +39,9 @@ def post_lock_command(scene, times, values, t_lock, rate_limit):
     u_lock = float(np.interp(t_lock, times, values))
     keep = times < t_lock
     p_hold = max(u_lock, scene.value("actuation.pressure"))
+    p_max = scene.get("actuation.max_pressure")
+    if p_max is not None:
+        u_lock, p_hold = min(u_lock, p_max), min(p_hold, p_max)
     ramp = max((p_hold - u_lock) / rate_limit, 1e-6)
     return (np.concatenate([times[keep], [t_lock, t_lock + ramp]]),
             np.concatenate([values[keep], [u_lock, p_hold]]))
@@ -96,7 +99,16 @@ def run_closed_loop(scene, feedback, t_end, *, nominal_scene=None, model=None, r
     k = 0
     t = 0.0
     while t < t_end - 1e-12:
-        if mode.endswith("locked"):
+        if not mode.endswith("locked"):
+            signals = {name: x[name] for name in ("w_in", "w_out", "p_valve") if name in x}
+            du, u_k, u_unsat = feedback.step(k, signals)
+            record["t"].append(t)
+            record["command_Pa"].append(u_k)
+            record["correction_Pa"].append(du)
+            record["command_unsat_Pa"].append(u_unsat)
+            record["integral_rad"].append(feedback.integral)
+        if mode.endswith("locked") or feedback.finished:
+            # hand over to the clamp ramp, from the command the TCU applies now
             u_now = feedback.feedforward(t - feedback.shift) + (record["correction_Pa"][-1] if record["t"] else 0.0)
             c_times, c_values = post_lock_command(nominal_scene or scene, np.append(record["t"], t),
                                                   np.append(record["command_Pa"], u_now), t, feedback.rate_limit)
@@ -106,13 +118,6 @@ def run_closed_loop(scene, feedback, t_end, *, nominal_scene=None, model=None, r
             segments += piece.segments
             events += piece.events
             break
-        signals = {name: x[name] for name in ("w_in", "w_out", "p_valve") if name in x}
-        du, u_k, u_unsat = feedback.step(k, signals)
-        record["t"].append(t)
-        record["command_Pa"].append(u_k)
-        record["correction_Pa"].append(du)
-        record["command_unsat_Pa"].append(u_unsat)
-        record["integral_rad"].append(feedback.integral)
         t_next = min(t + Ts, t_end)
         u = model.inputs(feedback.ff_times + feedback.shift, feedback.ff_values + du)
         piece = simulate(model.hybrid, x, np.linspace(t, t_next, POINTS_PER_SAMPLE), mode=mode, u=u, options=options)

@@ -47,10 +47,19 @@ class SlipFeedback:
     rate_limit : float
         Largest command rate [Pa/s].
     anti_windup : {"clamping", "none"}
+    path : (array, array), optional
+        The falling branch of the nominal slip: times [s] and slip [rad/s]. Given, the reference time
+        tau of a sample on that branch is the time at which the nominal slip equals the measured one
+        (slip progress), not the clock: the clutch follows the optimal slip path at its own pace, so a
+        clutch that is a little slow or fast still approaches lock-up as the optimum does (slip rate
+        falling to zero with the slip: no torque jump). Before the branch tau = t.
+    max_delay : float
+        The reference time never lags the clock by more than this [s]: a slow clutch is then pushed
+        along in time (the slip error and its integral act).
     """
 
     def __init__(self, sample_time, gains, integral_gains, reference, slip_reference, measured, feedforward,
-                 p_min, p_max, rate_limit, anti_windup="clamping", path=None):
+                 p_min, p_max, rate_limit, anti_windup="clamping", path=None, max_delay=np.inf):
         self.Ts = float(sample_time)
         self.gains = np.atleast_2d(np.asarray(gains, float))
         self.integral_gains = np.asarray(integral_gains, float).ravel()
@@ -70,6 +79,7 @@ class SlipFeedback:
         self.anti_windup = anti_windup
         self.enabled = True
         self.path = None if path is None else tuple(np.asarray(a, float) for a in path)
+        self.max_delay = float(max_delay)
         self.reset()
 
     @property
@@ -81,6 +91,7 @@ class SlipFeedback:
         """Before a run: zero integral, no previous sample."""
         self.integral = 0.0
         self.progress = 0.0
+        self._last_t = 0.0
         self._previous_slip = None
         self._previous_command = None
 
@@ -98,7 +109,12 @@ class SlipFeedback:
         if t < t_path[0]:
             return t
         tau = float(np.interp(-w_rel, -w_path, t_path)) if w_rel < w_path[0] else t_path[0]
-        return max(tau, self.progress)
+        return max(tau, self.progress, t - self.max_delay)
+
+    @property
+    def finished(self):
+        """True once the reference has run out (its time past the nominal lock-up): time to clamp."""
+        return self.progress >= self.horizon * self.Ts
 
     def _at(self, table, tau):
         """Row of a per-sample table at reference time tau (linear between samples, ends held)."""
@@ -112,10 +128,6 @@ class SlipFeedback:
     def _reference(self, tau):
         ref = self._at(self.reference, tau)
         slip = float(self._at(self.slip_reference[:, None], tau)[0])
-        if tau > self.horizon * self.Ts:           # past the nominal lock-up: hold the locked state
-            ref = ref.copy()
-            ref[self.measured.index("slip_rate")] = 0.0
-            slip = 0.0
         return ref, slip
 
     def step(self, k, signals):

@@ -190,5 +190,6 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
         fall = slice(peak, None)
         path = (np.append(t_slip[fall], t_lock), np.append(w_slip[fall], 0.0))
     feedback = SlipFeedback(Ts, gains, K[:, 0, n], ref, slip_ref, measured, (times, values), p_lo, p_hi,
-                            (p_hi - p_lo) / spec.rate_limit_time, spec.anti_windup, path=path)
+                            (p_hi - p_lo) / spec.rate_limit_time, spec.anti_windup, path=path,
+                            max_delay=spec.max_delay)
     return SlipFeedbackDesign(feedback, nominal, t_lock, sample_times, Phi, Gamma, K, P, lin.state_names, spec)

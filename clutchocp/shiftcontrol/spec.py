@@ -10,6 +10,8 @@ field::
     pressure_min = "0 MPa"           # command limits (default: 0 .. actuation.max_pressure)
     rate_limit_time = "10 ms"        # the command may cross its whole range in this time, no faster
     measure_pressure = true          # the TCU reads the clutch pressure (else speeds only)
+    progress = "slip"                # reference read at the slip reached ("slip") or at the clock ("time")
+    max_delay = "10 ms"              # with "slip": the reference lags the clock by at most this
 
     [lqi]                            # Bryson's rule: each weight is 1 / tolerance^2
     slip_tolerance = 0.01            # slip error, fraction of the initial slip
@@ -43,6 +45,7 @@ _CONTROLLER = {
     "rate_limit_time": ("s", "positive", 0.01),
     "measure_pressure": ("bool", None, True),
     "progress": ("choice", PROGRESS, "slip"),
+    "max_delay": ("s", "nonnegative", 0.01),
 }
 _LQI = {
     "slip_tolerance": ("1", "positive", 0.01),
@@ -68,6 +71,7 @@ class SlipControlSpec:
     rate_limit_time: float = 0.01
     measure_pressure: bool = True
     progress: str = "slip"
+    max_delay: float = 0.01
     lqi: dict = field(default_factory=lambda: {k: v[2] for k, v in _LQI.items()})
     anti_windup: str = "clamping"
     path: Path | None = None
@@ -118,5 +122,5 @@ def parse_slip_spec(raw):
     return SlipControlSpec(sample_time=c["sample_time"], name=c["name"], description=c["description"],
                            pressure_min=c["pressure_min"], pressure_max=c["pressure_max"],
                            rate_limit_time=c["rate_limit_time"], measure_pressure=c["measure_pressure"],
-                           progress=c["progress"],
+                           progress=c["progress"], max_delay=c["max_delay"],
                            lqi=weights, anti_windup=values["anti_windup"]["method"])

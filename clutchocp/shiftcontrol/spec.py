@@ -11,11 +11,11 @@ field::
     rate_limit_time = "10 ms"        # the command may cross its whole range in this time, no faster
     measure_pressure = true          # the TCU reads the clutch pressure (else speeds only)
     progress = "slip"                # reference read at the slip reached ("slip") or at the clock ("time")
-    max_delay = "10 ms"              # with "slip": the reference lags the clock by at most this
+    max_delay = "50 ms"              # with "slip": the reference lags the clock by at most this
 
     [lqi]                            # Bryson's rule: each weight is 1 / tolerance^2
-    slip_tolerance = 0.01            # slip error, fraction of the initial slip
-    slip_rate_tolerance = 0.03       # slip-rate error, fraction of initial slip / nominal lock time
+    slip_tolerance = 0.003           # slip error, fraction of the initial slip
+    slip_rate_tolerance = 0.1        # slip-rate error, fraction of initial slip / nominal lock time
     integral_tolerance = 0.01        # slip-error integral, fraction of initial slip x nominal lock time
     correction_tolerance = 0.3       # feedback correction, fraction of the pressure range
     terminal_weight = 10.0           # the state weights at lock-up are this many times larger
@@ -45,11 +45,11 @@ _CONTROLLER = {
     "rate_limit_time": ("s", "positive", 0.01),
     "measure_pressure": ("bool", None, True),
     "progress": ("choice", PROGRESS, "slip"),
-    "max_delay": ("s", "nonnegative", 0.01),
+    "max_delay": ("s", "nonnegative", 0.05),
 }
 _LQI = {
-    "slip_tolerance": ("1", "positive", 0.01),
-    "slip_rate_tolerance": ("1", "positive", 0.03),
+    "slip_tolerance": ("1", "positive", 0.003),
+    "slip_rate_tolerance": ("1", "positive", 0.1),
     "integral_tolerance": ("1", "positive", 0.01),
     "correction_tolerance": ("1", "positive", 0.3),
     "terminal_weight": ("1", "nonnegative", 10.0),
@@ -71,7 +71,7 @@ class SlipControlSpec:
     rate_limit_time: float = 0.01
     measure_pressure: bool = True
     progress: str = "slip"
-    max_delay: float = 0.01
+    max_delay: float = 0.05
     lqi: dict = field(default_factory=lambda: {k: v[2] for k, v in _LQI.items()})
     anti_windup: str = "clamping"
     path: Path | None = None

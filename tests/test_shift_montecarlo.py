@@ -56,3 +56,31 @@ def test_robust_run_is_reproducible_with_its_seed(tmp_path):
     assert set(summary["statistics"]) >= {"baseline", "nominal_optimum", "closed_loop"}
     for name in ("jump_vs_fields.png", "distributions.png", "envelopes.png"):
         assert (tmp_path / "a" / name).stat().st_size > 10_000
+
+
+def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch):
+    """Plumbing only: a stand-in for clutchocp.optimal.robust.solve_robust (contract: one shared command,
+    per-scenario lock times) returns the nominal optimum; the strategy list and the closed loop's
+    feedforward must pick it up."""
+    from types import SimpleNamespace
+
+    from clutchocp.optimal.problem import EngagementOCP
+    from clutchocp.shiftcontrol import report
+    from clutchocp.shiftcontrol.spec import load_slip_spec
+
+    scene = default_scene()
+    seen = {}
+
+    def stand_in(nominal, scenarios, *, t_max=None, intervals=60, **_):
+        seen["scenarios"] = scenarios
+        opt = EngagementOCP(nominal, intervals=intervals).solve(t_max=t_max)
+        return SimpleNamespace(success=True, command_times=opt.command_times, command=opt.command,
+                               scenarios=[opt], stats={"status": "stand-in"})
+
+    monkeypatch.setattr(report, "robust_solver", lambda: stand_in)
+    strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene),
+                                                load_slip_spec(), intervals=30, say=lambda *a: None)
+    assert [s.name for s in strategies] == ["baseline", "nominal_optimum", "robust_feedforward", "closed_loop"]
+    assert facts["closed_loop"]["feedforward"] == "robust_feedforward"
+    assert len(seen["scenarios"]) == 9                       # 2^3 corners and the centre
+    assert facts["robust_feedforward"]["stats"] == {"status": "stand-in"}

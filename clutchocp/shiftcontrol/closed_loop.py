@@ -34,7 +34,7 @@ def post_lock_command(scene, times, values, t_lock, rate_limit):
     except ImportError:
         extend_to_clamp = None
     if extend_to_clamp is not None:
-        t_out, p_out = extend_to_clamp(scene, times, values, t_lock)
+        t_out, p_out = extend_to_clamp(scene, times, values, t_lock, rate_limit=rate_limit)
         return np.asarray(t_out, float), np.asarray(p_out, float)
     u_lock = float(np.interp(t_lock, times, values))
     keep = times < t_lock
@@ -110,8 +110,10 @@ def run_closed_loop(scene, feedback, t_end, *, nominal_scene=None, model=None, r
         if mode.endswith("locked") or feedback.finished:
             # hand over to the clamp ramp, from the command the TCU applies now
             u_now = feedback.feedforward(t - feedback.shift) + (record["correction_Pa"][-1] if record["t"] else 0.0)
-            c_times, c_values = post_lock_command(nominal_scene or scene, np.append(record["t"], t),
-                                                  np.append(record["command_Pa"], u_now), t, feedback.rate_limit)
+            before = np.asarray(record["t"]) < t - 1e-12
+            c_times, c_values = post_lock_command(nominal_scene or scene, np.append(np.asarray(record["t"])[before], t),
+                                                  np.append(np.asarray(record["command_Pa"])[before], u_now), t,
+                                                  feedback.rate_limit)
             handover = t
             grid = np.linspace(t, t_end, max(int(round((t_end - t) / 0.001)), 2) + 1)
             piece = simulate(model.hybrid, x, grid, mode=mode, u=model.inputs(c_times, c_values), options=options)

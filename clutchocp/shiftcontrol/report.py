@@ -84,7 +84,9 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         r_times, r_values = post_lock_command(scene, rob.command_times, rob.command, t_end_command, rate)
         strategies.append(Strategy("robust_feedforward", "robust feedforward + clamp", r_times, r_values))
         feedforward = ("robust_feedforward", np.asarray(rob.command_times), np.asarray(rob.command))
-        facts["robust_feedforward"] = {"scenarios": len(scenarios), "stats": rob.stats}
+        facts["robust_feedforward"] = {"scenarios": len(scenarios), "lock_times_s": [float(s.t_f) for s in rob.scenarios],
+                                       "stats": {k: v for k, v in rob.stats.items()
+                                                 if isinstance(v, (bool, int, float, str))}}
     say(f"  slip feedback on the {feedforward[0].replace('_', ' ')}: {spec.label}, Ts = {spec.sample_time * 1e3:g} ms")
     design = design_slip_feedback(scene, feedforward[1], feedforward[2], spec)
     strategies.append(Strategy("closed_loop", f"slip feedback on {feedforward[0].replace('_', ' ')}",

@@ -55,8 +55,8 @@ def _options(scene, rtol=None, atol=None):
 def run_open_loop(scene, times, values, t_end, *, model=None, rtol=None, atol=None):
     """IDAS run of a piecewise-linear command (through ``times``, ``values``; last value held) to ``t_end``.
 
-    Output points every Ts / 10 at the default 10 ms (``POINTS_PER_SAMPLE``) so that jerk integrals are
-    taken on the same grid as the closed loop's. Returns an EngagementResult.
+    Output points every 1 ms, as the closed loop's at 10 ms (``POINTS_PER_SAMPLE``), so that jerk integrals
+    are taken on the same grid. Returns an EngagementResult.
     """
     points = int(round(t_end / 0.001)) + 1
     return simulate_command(scene, times, values, t_end, model=model, control="linear", points=points,

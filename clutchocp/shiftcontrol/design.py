@@ -64,14 +64,15 @@ def pressure_limits(scene, spec):
     return lo, hi
 
 
-def _slip_trajectory(run, names):
-    """Slip-phase samples of a run: (times, values (len, len(names)), algebraic values or None)."""
+def _slip_trajectory(run, names, z_names=()):
+    """Slip-phase samples of a run: times, states (len, len(names)), algebraic values (len, len(z_names))."""
     res = run.result
     mask = np.asarray(res.mode) == SLIP_MODE
     t, order = np.unique(res.t[mask], return_index=True)
     idx = np.nonzero(mask)[0][order]
     x = np.column_stack([res[n][idx] for n in names])
-    return t, x
+    z = np.column_stack([res[n][idx] for n in z_names]) if z_names else np.zeros((t.size, 0))
+    return t, x, z
 
 
 def design_slip_feedback(scene, command_times, command, spec, *, model=None):
@@ -115,10 +116,13 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
     grid = np.concatenate([starts, mids.ravel(), [t_lock]])
     nominal = simulate_command(scene, times, values, min(horizon, t_lock + 2 * Ts), model=model, control="linear",
                                points=101, extra_times=grid[grid < t_lock])
-    t_slip, x_slip = _slip_trajectory(nominal, lin.all_states)
+    t_slip, x_slip, z_slip = _slip_trajectory(nominal, lin.all_states, lin.z_names)
 
     def state_at(t):
         return np.array([np.interp(t, t_slip, x_slip[:, j]) for j in range(x_slip.shape[1])])
+
+    def alg_at(t):
+        return np.array([np.interp(t, t_slip, z_slip[:, j]) for j in range(z_slip.shape[1])])
 
     def ff(t):
         return np.interp(t, times, values)
@@ -127,15 +131,15 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
     Phi, Gamma, rows = np.zeros((N, n, n)), np.zeros((N, n, 1)), []
     for k in range(N):
         points = np.array([state_at(t) for t in mids[k]])
-        Phi[k], Gamma[k] = lin.sample_map(points, ff(mids[k]), (ends[k] - starts[k]) / SUBSTEPS)
-        rows.append(lin.continuous(state_at(starts[k]), ff(starts[k]))[2])
-    x_end = x_slip[-1]
-    C_end = lin.continuous(x_end, ff(t_slip[-1]))[2]
+        Phi[k], Gamma[k] = lin.sample_map(points, ff(mids[k]), (ends[k] - starts[k]) / SUBSTEPS,
+                                          np.array([alg_at(t) for t in mids[k]]))
+        rows.append(lin.continuous(state_at(starts[k]), ff(starts[k]), alg_at(starts[k]))[2])
+    C_end = lin.continuous(x_slip[-1], ff(t_slip[-1]), z_slip[-1])[2]
     sig = {name: j for j, name in enumerate(lin.signals)}
 
     # weights on scaled deviations
     w = spec.lqi
-    w_rel0 = lin.signal_values(state_at(0.0), ff(0.0))["w_rel"]
+    w_rel0 = lin.signal_values(state_at(0.0), ff(0.0), alg_at(0.0))["w_rel"]
     e_s, r_s, xi_s, p_s = abs(w_rel0), abs(w_rel0) / t_lock, abs(w_rel0) * t_lock, p_hi - p_lo
 
     def state_weight(C):
@@ -170,12 +174,12 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
     ref = np.zeros((N + 1, len(measured)))
     slip_ref = np.zeros(N + 1)
     for k, t in enumerate(sample_times):
-        x = state_at(min(t, t_slip[-1]))
-        values_k = lin.signal_values(x, ff(t))
+        t_in = min(t, t_slip[-1])
+        values_k = lin.signal_values(state_at(t_in), ff(t), alg_at(t_in))
         slip_ref[k] = values_k["w_rel"] if t < t_lock else 0.0
         for j, name in enumerate(measured):
             ref[k, j] = values_k[name] if name != "slip_rate" else 0.0
-    ref[0, 0] = lin.signal_values(state_at(0.0), ff(0.0))["slip_rate"]
+    ref[0, 0] = lin.signal_values(state_at(0.0), ff(0.0), alg_at(0.0))["slip_rate"]
     ref[1:, 0] = np.diff(slip_ref) / Ts            # the TCU's difference rate of the nominal slip
     if N >= 1:
         # at t_N the nominal clutch is locked: both speeds at the common speed just after lock-up
@@ -185,7 +189,7 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
                 ref[N, j] = lock.x_after[name]
     path = None
     if spec.progress == "slip":
-        w_slip = np.array([lin.signal_values(x, ff(t))["w_rel"] for t, x in zip(t_slip, x_slip)])
+        w_slip = np.array([lin.signal_values(x, ff(t), z)["w_rel"] for t, x, z in zip(t_slip, x_slip, z_slip)])
         peak = int(np.argmax(w_slip))
         fall = slice(peak, None)
         path = (np.append(t_slip[fall], t_lock), np.append(w_slip[fall], 0.0))

@@ -84,7 +84,8 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         r_times, r_values = post_lock_command(scene, rob.command_times, rob.command, t_end_command, rate)
         strategies.append(Strategy("robust_feedforward", "robust feedforward + clamp", r_times, r_values))
         feedforward = ("robust_feedforward", np.asarray(rob.command_times), np.asarray(rob.command))
-        facts["robust_feedforward"] = {"scenarios": len(scenarios), "lock_times_s": [float(s.t_f) for s in rob.scenarios],
+        facts["robust_feedforward"] = {"scenarios": len(scenarios),
+                                       "lock_times_s": [float(s.t_f) for s in rob.scenarios],
                                        "stats": {k: v for k, v in rob.stats.items()
                                                  if isinstance(v, (bool, int, float, str))}}
     say(f"  slip feedback on the {feedforward[0].replace('_', ' ')}: {spec.label}, Ts = {spec.sample_time * 1e3:g} ms")
@@ -280,8 +281,8 @@ def plot_distributions(out, rows, strategies, t_max):
     """Box plots per strategy: |jump| [% of locked torque] and engagement time [s] (with t_max)."""
     fig, (ax1, ax2) = new_figure(2, width=5.2, height=4.2)
     names = [s.name for s in strategies]
-    labels = [f"{s.label}\nlocked {100 * np.mean([r['locked_within_t_max'] for r in rows if r['strategy'] == s.name]):.0f} %"
-              for s in strategies]
+    share = {n: 100 * np.mean([r["locked_within_t_max"] for r in rows if r["strategy"] == n]) for n in names}
+    labels = [f"{s.label}\nlocked in t_max {share[s.name]:.0f} %" for s in strategies]
     for ax, key, title in ((ax1, "jump_pct", "|torque jump at lock-up| [% of locked torque]"),
                            (ax2, "engagement_time_s", "lock-up time [s]")):
         data = [[r[key] for r in rows if r["strategy"] == n and r[key] is not None] or [np.nan] for n in names]

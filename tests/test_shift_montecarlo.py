@@ -33,7 +33,7 @@ def test_samples_are_reproducible_with_the_seed_and_differ_with_another():
     for row in first:
         assert row["locked"] and row["jump_pct"] == pytest.approx(
             100 * abs(row["lockup_torque_jump_Nm"]) / row["locked_torque_Nm"])
-        assert row["locked_within_t_max"] == (row["engagement_time_s"] <= 0.22)
+        assert row["locked_within_t_max"] == (row["engagement_time_s"] <= 0.22 * 1.01)
 
 
 def test_statistics_of_rows():

@@ -9,6 +9,7 @@ parallel processes. Writes summary.json, samples.csv and three figures.
 """
 
 import sys
+import textwrap
 import time
 from pathlib import Path
 
@@ -255,13 +256,15 @@ def plot_jump_vs_fields(out, rows, uncertainty, strategies):
     numeric = [s.key for s in uncertainty.spreads if s.kind != "values"]
     if not numeric:
         return []
-    fig, axes = new_figure(len(numeric), width=4.6, height=4.0)
-    top = max([r["jump_pct"] for r in rows if r["jump_pct"] is not None] + [1.0]) * 1.15
+    fig, axes = new_figure(len(numeric), width=4.6, height=4.3)
+    values = [r["jump_pct"] for r in rows if r["jump_pct"] is not None]
+    floor = max(min(values + [2.0]) * 0.5, 1e-3)
+    top = max(values + [1.0]) * 2.0
     for ax, key in zip(axes, numeric):
         for s in strategies:
             mine = [r for r in rows if r["strategy"] == s.name]
             x = [r[key] for r in mine if r["jump_pct"] is not None]
-            y = [r["jump_pct"] for r in mine if r["jump_pct"] is not None]
+            y = [max(r["jump_pct"], floor) for r in mine if r["jump_pct"] is not None]
             ax.scatter(x, y, s=9, alpha=0.6, color=COLOURS.get(s.name), label=s.label)
             miss = [r[key] for r in mine if r["jump_pct"] is None]
             if miss:
@@ -269,9 +272,11 @@ def plot_jump_vs_fields(out, rows, uncertainty, strategies):
         ax.axhline(3.0, color="k", lw=0.8, ls="--")
         ax.set_xlabel(_label(key))
         ax.set_ylabel("|torque jump at lock-up| [% of locked torque]")
-        ax.set_yscale("symlog", linthresh=1.0)
-        ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=7, loc="upper left")
+        ax.set_yscale("log")
+        ax.set_ylim(floor, top * 1.5)
+        ax.grid(alpha=0.3, which="both")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=len(strategies), fontsize=8)
     fig.suptitle(f"Torque jump at lock-up over {len({r['sample'] for r in rows})} samples "
                  f"(x at the top: no lock-up; dashed: 3 %)", fontsize=10)
     return [save_figure(fig, out / "jump_vs_fields.png")]
@@ -279,13 +284,14 @@ def plot_jump_vs_fields(out, rows, uncertainty, strategies):
 
 def plot_distributions(out, rows, strategies, t_max):
     """Box plots per strategy: |jump| [% of locked torque] and engagement time [s] (with t_max)."""
-    fig, (ax1, ax2) = new_figure(2, width=5.2, height=4.2)
+    fig, (ax1, ax2) = new_figure(2, width=5.6, height=4.6)
     names = [s.name for s in strategies]
     share = {n: 100 * np.mean([r["locked_within_t_max"] for r in rows if r["strategy"] == n]) for n in names}
-    labels = [f"{s.label}\nlocked in t_max {share[s.name]:.0f} %" for s in strategies]
+    labels = [textwrap.fill(s.label, 22) + f"\nlocked in t_max: {share[s.name]:.0f} %" for s in strategies]
     for ax, key, title in ((ax1, "jump_pct", "|torque jump at lock-up| [% of locked torque]"),
                            (ax2, "engagement_time_s", "lock-up time [s]")):
-        data = [[r[key] for r in rows if r["strategy"] == n and r[key] is not None] or [np.nan] for n in names]
+        data = [[max(r[key], 1e-3) for r in rows if r["strategy"] == n and r[key] is not None] or [np.nan]
+                for n in names]
         box = ax.boxplot(data, whis=(5, 95), showfliers=True, patch_artist=True)
         for patch, n in zip(box["boxes"], names):
             patch.set_facecolor(COLOURS.get(n, "white"))
@@ -294,7 +300,8 @@ def plot_distributions(out, rows, strategies, t_max):
         ax.set_ylabel(title)
         ax.grid(alpha=0.3, axis="y")
     ax1.axhline(3.0, color="k", lw=0.8, ls="--", label="3 %")
-    ax1.set_yscale("symlog", linthresh=1.0)
+    ax1.set_yscale("log")
+    ax1.set_ylim(bottom=min(ax1.get_ylim()[0], 1.0))
     ax1.legend(fontsize=7)
     ax2.axhline(t_max, color="k", lw=0.8, ls="--", label=f"t_max = {t_max:.3f} s")
     ax2.legend(fontsize=7)

@@ -133,8 +133,12 @@ def run_robust(scene=None, out_dir="out/robust", *, samples=200, seed=0, uncerta
         scene = default_scene()
     elif isinstance(scene, (str, Path)):
         scene = load_scene(scene)
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
-        raise ModelError(f"samples = {samples!r}: must be a whole number >= 1")
+    for name, value, allowed in (("samples", samples, False), ("workers", workers, True),
+                                 ("intervals", intervals, False)):
+        if value is None and allowed:
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+            raise ModelError(f"{name} = {value!r}: must be a whole number >= 1")
     spec = load_slip_spec(controller)
     uncertainty = Uncertainty.from_scene(scene, extra=tuple(uncertain))
     if not uncertainty:

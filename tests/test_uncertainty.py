@@ -140,3 +140,13 @@ def test_scenes_command_lists_the_uncertainty_and_rejects_a_bad_one(tmp_path):
                          capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2
     assert bad.stderr.count("\n") == 1 and "uncertainty.friction.mu" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_a_run_whose_overrides_change_an_uncertain_part_does_not_depend_on_the_spread(tmp_path):
+    table = tmp_path / "load.csv"
+    table.write_text("speed,torque\n0,100\n400,100\n")
+    scene = load_scene("default_driveline", overrides={"load.model": "table", "load.file": str(table),
+                                                       "load.torque": None})
+    assert scene.variant("load") == "table"
+    with pytest.raises(SceneError, match="uncertainty.load.torque"):
+        scene.uncertainty

@@ -255,13 +255,11 @@ class Scene:
     """
 
     def __init__(self, raw, path=None):
-        from ..uncertainty import Uncertainty
-
         self.raw = raw
         self.path = Path(path) if path else None
+        self._uncertainty = None
         try:
             self._values = validate(raw, self.path.parent if self.path else Path.cwd())
-            self.uncertainty = Uncertainty.from_scene(self, check=False)
         except SceneError as exc:
             if self.path is None:
                 raise
@@ -323,6 +321,21 @@ class Scene:
             else:
                 raw.setdefault(part, {})[key] = value
         return Scene(raw, self.path)
+
+    @property
+    def uncertainty(self):
+        """The spread of the clutches this scene stands for (:class:`clutchocp.uncertainty.Uncertainty`,
+        empty if the scene has no ``[uncertainty]`` table). Read when first asked for, so that a
+        deterministic run of a scene whose overrides change a part (e.g. ``load.model``) does not
+        depend on it; studies that use it check it first (``Uncertainty.from_scene``)."""
+        if self._uncertainty is None:
+            from ..uncertainty import Uncertainty
+
+            try:
+                self._uncertainty = Uncertainty.from_scene(self, check=False)
+            except SceneError as exc:
+                raise type(exc)(f"{self.path.name}: {exc}" if self.path else str(exc)) from None
+        return self._uncertainty
 
     def without_uncertainty(self):
         """The same scene without its ``[uncertainty]`` table (one deterministic clutch)."""

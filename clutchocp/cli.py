@@ -231,6 +231,14 @@ def _cmd_optimize(args):
     return 0
 
 
+def _cmd_robust(args):
+    from .shiftcontrol.report import run_robust
+
+    run_robust(args.scene, out_dir=args.out, samples=args.samples, seed=args.seed, uncertain=args.uncertain,
+               t_max=args.t_max, controller=args.controller, workers=args.workers, intervals=args.intervals)
+    return 0
+
+
 def _cmd_bench(args):
     from .bench import format_summary, run_bench
 
@@ -313,6 +321,20 @@ def build_parser():
     p.add_argument("--controller", default=None, help="controller spec name (lqi, pi) or TOML file (default: lqi)")
     p.add_argument("--out", default="out/control", help="output folder (default: out/control)")
     p.set_defaults(run=_cmd_control)
+    p = sub.add_parser("robust", help="Monte Carlo of shift-control strategies over the scene's uncertainty "
+                                      "(baseline, nominal optimum, robust feedforward, slip feedback)")
+    p.add_argument("scene", nargs="?", default=None, help="engagement scene (default: the default scene)")
+    p.add_argument("--out", default="out/robust", help="output folder (default: out/robust)")
+    p.add_argument("--samples", type=int, default=200, help="draws of the uncertainty (default: 200)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the draws (default: 0)")
+    p.add_argument("--uncertain", action="append", default=[], metavar="PART.KEY=SPEC",
+                   help="add or replace an uncertain field, e.g. --uncertain 'friction.mu=uniform 10 %%' (repeatable)")
+    p.add_argument("--t-max", type=float, default=None,
+                   help="engagement-time limit [s] (default: lock-up time of the scene's own profile)")
+    p.add_argument("--controller", default="slip_lqr", help="slip-feedback spec name or TOML file (default: slip_lqr)")
+    p.add_argument("--workers", type=int, default=None, help="parallel processes (default: the local cores)")
+    p.add_argument("--intervals", type=int, default=60, help="collocation intervals of the optimisations (default: 60)")
+    p.set_defaults(run=_cmd_robust)
     return parser
 
 

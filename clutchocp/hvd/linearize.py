@@ -55,16 +55,39 @@ def linearize(model, point, outputs=(SPEED_OUTPUT,)):
         raise ModelError(f"outputs {unknown} are not outputs of the HVD model; known: {list(model.outputs)}")
     jac = _jacobian_function(model, outputs)
     fx, fz, fu, gx, gz, gu, cx, cz, cu = (np.array(m, dtype=float) for m in jac(point.x, point.z, point.u))
-    if gz.size:
-        if np.linalg.cond(gz) > 1e14:
-            raise ModelError("linearisation: d alg / d z is singular at this point (the DAE is not index 1 here)")
-        solve_x, solve_u = np.linalg.solve(gz, gx), np.linalg.solve(gz, gu)
-        A, B = fx - fz @ solve_x, fu - fz @ solve_u
-        C, D = cx - cz @ solve_x, cu - cz @ solve_u
-    else:
-        A, B, C, D = fx, fu, cx, cu
+    (A, B), (C, D) = eliminate_algebraic(gx, gz, gu, (fx, fz, fu), (cx, cz, cu))
     return control.ss(A, B, C, D, inputs=list(model.u), outputs=list(outputs), states=list(model.x),
                       name=f"hvd_{model.scene.name}")
+
+
+def eliminate_algebraic(gx, gz, gu, *blocks):
+    """Jacobians with the algebraic variables eliminated (implicit function theorem).
+
+    With 0 = g(x, z, u) and g_z non-singular, dz = -g_z^-1 (g_x dx + g_u du), so an expression
+    h(x, z, u) has the total Jacobians H_x = h_x - h_z g_z^-1 g_x and H_u = h_u - h_z g_z^-1 g_u.
+
+    Parameters
+    ----------
+    gx, gz, gu : numpy.ndarray
+        Jacobians of the algebraic residuals (gz square; empty if there are none).
+    *blocks : (hx, hz, hu) tuples of numpy.ndarray
+        Jacobians of each expression to reduce (the ODE right-hand side, outputs ...).
+
+    Returns
+    -------
+    list of (H_x, H_u), one per block.
+
+    Raises
+    ------
+    ModelError
+        g_z is singular (the DAE is not index 1 at this point).
+    """
+    if not gz.size:
+        return [(hx, hu) for hx, _, hu in blocks]
+    if np.linalg.cond(gz) > 1e14:
+        raise ModelError("linearisation: d alg / d z is singular at this point (the DAE is not index 1 here)")
+    solve_x, solve_u = np.linalg.solve(gz, gx), np.linalg.solve(gz, gu)
+    return [(hx - hz @ solve_x, hu - hz @ solve_u) for hx, hz, hu in blocks]
 
 
 def reduced_rhs(model, x, u):

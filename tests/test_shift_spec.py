@@ -1,0 +1,50 @@
+"""Slip-feedback specs and the robust command's input checks: every mistake ends in one clear line."""
+
+import pytest
+
+from clutchocp.cli import main
+from clutchocp.errors import SceneError
+from clutchocp.shiftcontrol.spec import load_slip_spec, parse_slip_spec
+
+GOOD = {"controller": {"type": "slip_lqi", "sample_time": "10 ms"}}
+
+
+def test_builtin_spec_loads_with_units():
+    spec = load_slip_spec("slip_lqr")
+    assert spec.sample_time == pytest.approx(0.01)
+    assert spec.max_delay == pytest.approx(0.05)
+    assert spec.anti_windup == "clamping" and spec.progress == "slip"
+    assert spec.lqi["slip_tolerance"] == pytest.approx(0.003)
+
+
+@pytest.mark.parametrize("raw, match", [
+    ({"controller": {"type": "slip_lqi"}}, r"controller\.sample_time: missing"),
+    ({"controller": {"type": "pid", "sample_time": "10 ms"}}, r"controller\.type = 'pid': allowed values are slip_lqi"),
+    ({"controller": {"type": "slip_lqi", "sample_time": "-1 ms"}}, r"controller\.sample_time = '-1 ms': must be > 0"),
+    ({"controller": {"type": "slip_lqi", "sample_time": "10 kg"}}, r"controller\.sample_time"),
+    ({**GOOD, "lqi": {"slip_tolerence": 0.1}}, r"lqi\.slip_tolerence: unknown key .*did you mean 'slip_tolerance'"),
+    ({**GOOD, "lqi": {"slip_tolerance": 0}}, r"lqi\.slip_tolerance = 0: must be > 0"),
+    ({**GOOD, "anti_windup": {"method": "back_calculation"}}, r"anti_windup\.method .*allowed values are clamping, none"),
+    ({**GOOD, "scenario": {}}, r"\[scenario\]: unknown table"),
+    ({"controller": {**GOOD["controller"], "pressure_min": "1 MPa", "pressure_max": "0.5 MPa"}},
+     r"pressure_min = 1e\+06 Pa must be below"),
+    ({"controller": {**GOOD["controller"], "progress": "speed"}}, r"controller\.progress = 'speed': allowed values are slip, time"),
+])
+def test_bad_specs_raise_one_line(raw, match):
+    with pytest.raises(SceneError, match=match) as info:
+        parse_slip_spec(raw)
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["robust", "--samples", "0"], "samples = 0: must be a whole number >= 1"),
+    (["robust", "--workers", "0"], "workers = 0: must be a whole number >= 1"),
+    (["robust", "--uncertain", "friction.mu=uniform ten %"], "friction.mu"),
+    (["robust", "--uncertain", "friction.nu=uniform 10 %"], "friction.nu"),
+    (["robust", "--controller", "no_such_spec"], "no_such_spec"),
+])
+def test_robust_command_bad_input_exits_2_with_one_line(argv, match, capsys, tmp_path):
+    code = main(argv + ["--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and match in err[0] and err[0].startswith("clutchocp robust: error:")

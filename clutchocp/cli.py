@@ -109,6 +109,38 @@ def _cmd_bench(args):
     return 0
 
 
+def _cmd_sweep(args):
+    from .scene import parse_override
+    from .study import StudyInterrupted, run_sweep
+
+    if args.scheduler and args.engine not in (None, "dask"):
+        raise ModelError(f"--scheduler {args.scheduler}: needs --engine dask (or no --engine)")
+    engine = args.engine or ("dask" if args.scheduler else "local")
+    options = {"native": args.native}
+    if args.output_points is not None:
+        if args.output_points < 2:
+            raise ModelError(f"--output-points {args.output_points}: must be >= 2")
+        options["output_points"] = args.output_points
+    if args.task == "optimize":
+        options.update(intervals=args.intervals, degree=args.degree, t_max=args.t_max,
+                       weights=_parse_weights(args.weights) if args.weights else None,
+                       warm_start=not args.cold, verify=not args.no_verify)
+    try:
+        summary = run_sweep(args.scene, args.out, task=args.task, grid=args.grid, samples=args.samples,
+                            seed=args.seed, uncertain=args.uncertain,
+                            overrides=dict(parse_override(text) for text in args.set), options=options,
+                            engine=engine, workers=args.workers, scheduler=args.scheduler, progress=True)
+    except StudyInterrupted as exc:
+        print(f"clutchocp sweep: {exc}", file=sys.stderr)
+        return 130
+    rate = summary["points_per_second"]
+    print(f"{summary['scene']} {summary['task']} sweep: {summary['points']} points, {summary['points_ok']} ok, "
+          f"{summary['points_failed']} failed, {summary['points_resumed']} resumed; "
+          f"{summary['wall_time_s']:.1f} s" + (f" ({rate:.2f} points/s)" if rate else ""))
+    print(f"wrote {args.out}: " + ", ".join(Path(f).name for f in summary["files"]) + ", results.csv")
+    return 0
+
+
 def build_parser():
     """The argument parser of the ``clutchocp`` command."""
     parser = argparse.ArgumentParser(
@@ -154,6 +186,39 @@ def build_parser():
     p.add_argument("--controller", default=None, help="controller spec name (lqi, pi) or TOML file (default: lqi)")
     p.add_argument("--out", default="out/control", help="output folder (default: out/control)")
     p.set_defaults(run=_cmd_control)
+    p = sub.add_parser("sweep", help="many runs of a scene: a grid of operating points or Monte Carlo samples, "
+                                     "on local processes or a Dask cluster")
+    p.add_argument("scene", help="engagement scene name or TOML file")
+    p.add_argument("--task", default="simulate", choices=("simulate", "optimize"),
+                   help="what to do at each point (default: simulate)")
+    p.add_argument("--grid", action="append", default=[], metavar="PART.KEY=START:STOP:COUNT",
+                   help="a swept field (SI numbers or quantities, e.g. load.torque=50:150:5); repeat for a full grid")
+    p.add_argument("--samples", type=int, default=None, metavar="N",
+                   help="N samples of the scene's [uncertainty] (and --uncertain fields)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the samples (default: 0)")
+    p.add_argument("--uncertain", action="append", default=[], metavar="PART.KEY=DIST",
+                   help="an uncertain field, e.g. 'friction.mu=uniform 10 %%' (repeatable)")
+    p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
+                   help="override a scene value at every point (repeatable)")
+    p.add_argument("--out", default="out/sweep", help="output folder (default: out/sweep); a folder holding the "
+                                                      "same sweep is resumed")
+    p.add_argument("--engine", default=None, choices=("local", "dask", "serial"),
+                   help="local worker processes (default), dask (a LocalCluster, or --scheduler) or serial")
+    p.add_argument("--workers", type=int, default=None, help="local or LocalCluster workers (default: all cores)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (implies --engine dask)")
+    p.add_argument("--output-points", type=int, default=None,
+                   help="simulate: output times per run (default: the scene's simulation.output_points)")
+    p.add_argument("--native", action="store_true",
+                   help="simulate: compile each point's equations to C (pays off only for long runs)")
+    p.add_argument("--t-max", type=float, default=None,
+                   help="optimize: largest engagement time [s] (default: each point's own baseline lock-up time)")
+    p.add_argument("--weights", default=None, metavar="NAME=W,...", help="optimize: objective weights")
+    p.add_argument("--intervals", type=int, default=40, help="optimize: collocation intervals (default: 40)")
+    p.add_argument("--degree", type=int, default=3, help="optimize: collocation points per interval (default: 3)")
+    p.add_argument("--cold", action="store_true", help="optimize: no warm start from the neighbouring point")
+    p.add_argument("--no-verify", action="store_true", help="optimize: skip the IDAS replay of each optimum")
+    p.set_defaults(run=_cmd_sweep)
     return parser
 
 

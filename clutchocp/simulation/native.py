@@ -76,3 +76,21 @@ def native_dae(cm):
     dae = ca.Function(f"{cm.name}_dae", [d["t"], d["x"], d["z"], d["p"], empty], [d["ode"], d["alg"], empty, empty],
                       ca.dyn_in(), ca.dyn_out())
     return compile_function(dae, with_jacobian=True)
+
+
+def native_status(requested):
+    """Whether compiled native code is used, for a summary.
+
+    Parameters
+    ----------
+    requested : bool
+        Whether the run asked for native code.
+
+    Returns
+    -------
+    dict
+        ``requested``, ``used`` (requested and a C compiler exists) and ``compiler`` (its path, or
+        None: the equations are then evaluated by CasADi's virtual machine).
+    """
+    cc = compiler()
+    return {"requested": bool(requested), "used": bool(requested and cc is not None), "compiler": cc}

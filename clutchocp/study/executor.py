@@ -56,6 +56,14 @@ def default_workers():
         return os.cpu_count() or 1
 
 
+def check_engine(engine, workers):
+    """Raise ModelError for an unknown engine or a worker count that is not a whole number >= 1."""
+    if engine not in ENGINES:
+        raise ModelError(f"--engine {engine!r}: allowed values are {', '.join(ENGINES)}")
+    if workers is not None and not (isinstance(workers, int) and not isinstance(workers, bool) and workers >= 1):
+        raise ModelError(f"--workers {workers!r}: must be a whole number >= 1")
+
+
 def execute(task, units, on_result, *, engine="local", workers=None, scheduler=None, progress=True):
     """Run ``units`` (lists of points) of ``task``; call ``on_result(row, curve)`` per finished point.
 
@@ -85,10 +93,7 @@ def execute(task, units, on_result, *, engine="local", workers=None, scheduler=N
     StudyInterrupted
         On Ctrl-C, after the workers were stopped.
     """
-    if engine not in ENGINES:
-        raise ModelError(f"engine '{engine}': allowed values are {', '.join(ENGINES)}")
-    if workers is not None and not (isinstance(workers, int) and workers >= 1):
-        raise ModelError(f"--workers {workers!r}: must be a whole number >= 1")
+    check_engine(engine, workers)
     total = sum(len(u) for u in units)
     bar = tqdm(total=total, unit="point", file=sys.stderr, disable=not progress, dynamic_ncols=True,
                desc=f"{task.kind} {task.scene}")
@@ -145,7 +150,7 @@ def _run_dask(task, units, deliver, workers, scheduler):
     cluster = None
     try:
         if scheduler:
-            client = Client(scheduler, timeout="10s")
+            client = Client(scheduler, timeout="5s")
         else:
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None)

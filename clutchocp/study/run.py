@@ -9,7 +9,7 @@ from ..errors import ModelError
 from ..output import write_summary
 from ..scene import load_scene
 from ..simulation.native import native_status
-from .executor import execute
+from .executor import check_engine, execute
 from .figures import draw_study
 from .folder import StudyFolder
 from .points import StudySpecError, chains, grid_points, parse_grid, point_id
@@ -86,6 +86,7 @@ def run_sweep(scene, out_dir, *, task="simulate", grid=(), samples=None, seed=0,
     """
     if task not in TASKS:
         raise ModelError(f"--task {task!r}: allowed values are {', '.join(TASKS)}")
+    check_engine(engine, workers)
     overrides = dict(overrides or {})
     base = load_scene(scene, overrides=overrides or None)
     if base.kind != "engagement":

@@ -1,0 +1,151 @@
+"""Sweeps end to end: equal to single runs, failures recorded, Ctrl-C and resume, folder lock, optimize chains."""
+
+import csv
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from clutchocp.cli import main
+from clutchocp.engagement.run import simulate_engagement
+from clutchocp.optimal.problem import EngagementOCP
+from clutchocp.scene import load_scene
+from clutchocp.study import run_sweep
+from clutchocp.study.folder import CALIBRATION, LOCK, RESULTS, parse_cell
+from clutchocp.study.tasks import SIMULATE_COLUMNS
+
+ROOT = Path(__file__).resolve().parents[1]
+GRID_2x2 = ["actuation.pressure=0.4 MPa:0.8 MPa:2", "oil.viscosity=0.04:0.06:2"]
+
+
+def read_rows(folder):
+    with (Path(folder) / RESULTS).open(newline="") as fh:
+        return [{k: v if k in ("point_id", "status", "reason", "final_mode") else parse_cell(v) for k, v in r.items()}
+                for r in csv.DictReader(fh)]
+
+
+def cli(*args, **kw):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    return subprocess.Popen([sys.executable, "-m", "clutchocp.cli", *args], cwd=ROOT, env=env, text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, **kw)
+
+
+def test_a_four_point_sweep_on_two_workers_equals_four_single_runs(tmp_path):
+    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID_2x2, engine="local", workers=2, progress=False)
+    assert (summary["points"], summary["points_ok"], summary["engine"]["workers"]) == (4, 4, 2)
+    rows = read_rows(tmp_path / "s")
+    assert len(rows) == 4
+    base = load_scene("zhang2021")
+    for row in rows:
+        point = {"actuation.pressure": row["actuation.pressure"], "oil.viscosity": row["oil.viscosity"]}
+        single = simulate_engagement(base.with_overrides(point)).summary
+        for key in SIMULATE_COLUMNS[:-3]:                       # every number except run time and step count
+            assert row[key] == single[key], key                 # exactly: same equations, same steps
+        assert row["n_steps"] == single["solver"]["statistics"]["n_steps"]
+        assert row["final_mode"] == single["final_mode"]
+    assert (tmp_path / "s" / "sweep_maps.png").is_file() and (tmp_path / "s" / "summary.json").is_file()
+    assert not (tmp_path / "s" / LOCK).exists()
+
+
+def test_a_failing_point_is_recorded_with_its_reason_and_the_sweep_goes_on(tmp_path):
+    # Smooth plates without asperity contact: through a permeable lining the film drains completely
+    # and IDAS fails; without permeability the run completes (tests/test_extreme.py, same case).
+    smooth = {"contact.model": "none", "contact.E_equiv": None, "roughness.sigma": 0, "film.flow_factor": "none"}
+    summary = run_sweep("zhang2021", tmp_path / "s", grid=["plates.lining_permeability=0:4e-12:3"],
+                        overrides=smooth, engine="serial", progress=False)
+    rows = read_rows(tmp_path / "s")
+    assert [r["status"] for r in rows] == ["ok", "failed", "failed"]
+    for row in rows[1:]:
+        assert row["reason"].startswith("IDAS failed at t = ") and "Extreme case" in row["reason"]
+        assert "\n" not in row["reason"]
+        assert all(row[k] is None for k in SIMULATE_COLUMNS[:-1] if k != "final_mode")   # no numbers
+        assert row["final_mode"] == ""
+    assert summary["points_failed"] == 2 and len(summary["failures"]) == 2
+    assert summary["failures"][0]["plates.lining_permeability"] == pytest.approx(2e-12)
+    assert (tmp_path / "s" / "sweep_lines.png").is_file()
+
+
+def test_ctrl_c_stops_cleanly_and_the_same_command_resumes_without_recomputing(tmp_path):
+    out = tmp_path / "s"
+    args = ["sweep", "zhang2021", "--grid", "oil.viscosity=0.04:0.08:8", "--out", str(out), "--workers", "2"]
+    proc = cli(*args)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        if (out / RESULTS).is_file() and (out / RESULTS).read_text().count("\n") >= 3:      # header + 2 rows
+            break
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("clutchocp sweep: interrupted after") and "run the same command again to resume" in last
+    assert "Traceback" not in err
+    kept = read_rows(out)
+    assert 2 <= len(kept) < 8 and not (out / LOCK).exists()
+    assert not (out / "summary.json").exists()
+
+    proc = cli(*args[:-2], "--engine", "serial")                     # the engine is not part of the study
+    stdout, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err
+    assert f"{len(kept)} resumed" in stdout
+    rows = read_rows(out)
+    assert len(rows) == 8 and len({r["point_id"] for r in rows}) == 8
+    assert rows[:len(kept)] == kept                                  # finished rows untouched, not recomputed
+    assert sorted(r["oil.viscosity"] for r in rows) == pytest.approx([0.04 + 0.04 * k / 7 for k in range(8)])
+
+
+def test_a_sweep_into_a_folder_another_sweep_is_writing_is_refused_before_any_run(tmp_path, capsys):
+    out = tmp_path / "s"
+    out.mkdir()
+    holder = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        (out / LOCK).write_text(f"{holder.pid} {socket.gethostname()} 2026-11-23T12:00:00\n")
+        code = main(["sweep", "zhang2021", "--grid", "oil.viscosity=0.04:0.08:2", "--out", str(out)])
+    finally:
+        holder.kill()
+        holder.wait()
+    assert code == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        f"clutchocp sweep: error: --out {out}: another sweep (process {holder.pid} on {socket.gethostname()}) is "
+        f"writing into this folder ({LOCK}); wait for it to finish or choose another --out"]
+    assert sorted(p.name for p in out.iterdir()) == [LOCK]
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--grid", "oil.viscosty=0.02:0.06:3"], ["oil.viscosty", "did you mean 'viscosity'"]),
+    (["--grid", "oil.viscosity=0.02:0.06:3", "--samples", "5"], ["--grid", "--samples", "not both"]),
+    ([], ["--grid", "--samples"]),
+    (["--grid", "oil.viscosity=0.02:0.06:3", "--workers", "0"], ["--workers", ">= 1"]),
+    (["--grid", "oil.viscosity=0.02:0.06:3", "--scheduler", "tcp://127.0.0.1:1", "--engine", "local"],
+     ["--scheduler", "--engine dask"]),
+])
+def test_bad_sweep_input_is_one_line_and_exit_code_2(tmp_path, capsys, args, words):
+    code = main(["sweep", "zhang2021", "--out", str(tmp_path / "s"), *args])
+    assert code == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("clutchocp sweep: error:")
+    assert all(w in lines[0] for w in words)
+
+
+def test_an_optimize_chain_warm_starts_and_finds_the_cold_optimum(tmp_path):
+    options = {"intervals": 12, "verify": False}
+    run_sweep("default_driveline", tmp_path / "s", task="optimize", grid=["load.torque=90:110:2"],
+              options=options, engine="serial", progress=False)
+    rows = read_rows(tmp_path / "s")
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    assert [r["warm_start"] for r in rows] == [False, True]
+    scene = load_scene("default_driveline", overrides={"load.torque": rows[1]["load.torque"]})
+    cold = EngagementOCP(scene, intervals=12).solve()
+    assert rows[1]["objective"] == pytest.approx(cold.objective, rel=1e-6)
+    assert rows[1]["engagement_time_s"] == pytest.approx(cold.t_f, rel=1e-6)
+    with (tmp_path / "s" / CALIBRATION).open(newline="") as fh:
+        table = list(csv.DictReader(fh))
+    assert list(table[0]) == ["load.torque", "point_id", "time_s", "pressure_Pa"]
+    mine = [r for r in table if r["point_id"] == rows[1]["point_id"]]
+    assert [float(r["pressure_Pa"]) for r in mine] == pytest.approx(list(cold.command), rel=1e-5, abs=1e-3 * cold.command.max())
+    assert (tmp_path / "s" / "optimal_curves.png").is_file() and (tmp_path / "s" / "sweep_lines.png").is_file()

@@ -149,3 +149,16 @@ def test_an_optimize_chain_warm_starts_and_finds_the_cold_optimum(tmp_path):
     mine = [r for r in table if r["point_id"] == rows[1]["point_id"]]
     assert [float(r["pressure_Pa"]) for r in mine] == pytest.approx(list(cold.command), rel=1e-5, abs=1e-3 * cold.command.max())
     assert (tmp_path / "s" / "optimal_curves.png").is_file() and (tmp_path / "s" / "sweep_lines.png").is_file()
+
+
+def test_samples_are_the_seeded_draws_of_the_scene_uncertainty(tmp_path):
+    from clutchocp.uncertainty import Uncertainty
+
+    extra = ("actuation.time_constant=uniform 25 %",)
+    summary = run_sweep("zhang2021", tmp_path / "s", samples=3, seed=7, uncertain=extra, engine="serial",
+                        progress=False)
+    draws = Uncertainty.from_scene(load_scene("zhang2021"), extra=extra).samples(3, seed=7)
+    rows = read_rows(tmp_path / "s")
+    assert [r["actuation.time_constant"] for r in rows] == [d["actuation.time_constant"] for d in draws]
+    assert summary["fields"] == ["actuation.time_constant"] and summary["points_ok"] == 3
+    assert (tmp_path / "s" / "sample_histograms.png").is_file() and (tmp_path / "s" / "sample_scatter.png").is_file()

@@ -123,12 +123,12 @@ def _cmd_sweep(args):
     if args.scheduler and args.engine not in (None, "dask"):
         raise ModelError(f"--scheduler {args.scheduler}: needs --engine dask (or no --engine)")
     engine = args.engine or ("dask" if args.scheduler else "local")
-    options = {"native": args.native}
-    if args.output_points is not None:
-        if args.output_points < 2:
+    options = {}
+    if args.task == "simulate":
+        if args.output_points is not None and args.output_points < 2:
             raise ModelError(f"--output-points {args.output_points}: must be >= 2")
-        options["output_points"] = args.output_points
-    if args.task == "optimize":
+        options.update(native=args.native, output_points=args.output_points)
+    else:
         options.update(intervals=args.intervals, degree=args.degree, t_max=args.t_max,
                        weights=_parse_weights(args.weights) if args.weights else None,
                        warm_start=not args.cold, verify=not args.no_verify)

@@ -13,7 +13,7 @@ from .executor import check_engine, execute
 from .figures import draw_study
 from .folder import StudyFolder
 from .points import StudySpecError, chains, grid_points, parse_grid, point_id
-from .tasks import STATUS_COLUMNS, TASKS, Task
+from .tasks import STATUS_COLUMNS, Task
 
 MAX_LISTED_FAILURES = 20
 
@@ -84,15 +84,13 @@ def run_sweep(scene, out_dir, *, task="simulate", grid=(), samples=None, seed=0,
     dict
         The summary written to ``summary.json`` plus ``files`` (paths written).
     """
-    if task not in TASKS:
-        raise ModelError(f"--task {task!r}: allowed values are {', '.join(TASKS)}")
+    job = Task(str(scene), task, dict(overrides or {}), dict(options or {}))
     check_engine(engine, workers)
     overrides = dict(overrides or {})
     base = load_scene(scene, overrides=overrides or None)
     if base.kind != "engagement":
         raise ModelError(f"scene '{base.name}' is a {base.kind} scene; a sweep runs engagement scenes")
     fields, points = study_points(base, grid, samples, seed, uncertain)
-    job = Task(str(scene), task, overrides, dict(options or {}))
     columns = list(fields) + list(STATUS_COLUMNS) + list(job.columns())
     spec = {"scene": str(scene), "task": task, "fields": list(fields), "grid": list(grid), "samples": samples,
             "seed": seed if samples is not None else None, "uncertain": list(uncertain), "overrides": overrides,
@@ -155,5 +153,5 @@ def sweep_summary(scene, task, fields, rows, *, resumed, computed, wall, engine_
         "wall_time_s": wall,
         "points_per_second": computed / wall if computed and wall > 0 else None,
         "points_per_second_per_worker": computed / wall / workers if computed and wall > 0 and workers else None,
-        "native_code": native_status(bool(task.options.get("native", False))),
+        "native_code": native_status(bool(task.options.get("native", False))) if task.kind == "simulate" else None,
     }

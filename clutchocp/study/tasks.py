@@ -14,19 +14,34 @@ import functools
 import time
 from dataclasses import asdict, dataclass, field
 
-from ..errors import ClutchocpError
+from ..errors import ClutchocpError, ModelError
 from .points import point_id
 
 TASKS = ("simulate", "optimize")
 
 # Result columns per task, with units in the names (the CSV header and summary.json use them).
-SIMULATE_COLUMNS = ("engagement_time_s", "lockup_torque_jump_Nm", "peak_torque_Nm", "peak_jerk_rad_s3",
+SIMULATE_RESULTS = ("engagement_time_s", "lockup_torque_jump_Nm", "peak_torque_Nm", "peak_jerk_rad_s3",
                     "dissipated_energy_J", "energy_balance_rel_error", "torque_response_time_s",
-                    "pressure_response_time_s", "final_mode", "n_steps", "run_time_s")
+                    "pressure_response_time_s", "final_mode")
+SIMULATE_COLUMNS = SIMULATE_RESULTS + ("n_steps", "build_time_s", "integration_time_s", "run_time_s")
 OPTIMIZE_COLUMNS = ("engagement_time_s", "t_max_s", "jerk_integral", "dissipated_energy_J", "lockup_torque_jump_Nm",
                     "peak_jerk_rad_s3", "peak_torque_Nm", "objective", "ipopt_iterations", "solve_time_s",
                     "build_time_s", "warm_start", "idas_lock_time_rel_diff", "run_time_s")
 STATUS_COLUMNS = ("point_id", "status", "reason")
+# Options of each task with their defaults (see Task).
+DEFAULT_OPTIONS = {
+    "simulate": {"output_points": None, "rtol": None, "atol": None, "native": False},
+    "optimize": {"intervals": 40, "degree": 3, "t_max": None, "weights": None, "warm_start": True, "verify": True},
+}
+
+
+def task_options(kind, options):
+    """``options`` completed with the defaults of task ``kind`` (ModelError for an unknown option)."""
+    defaults = DEFAULT_OPTIONS[kind]
+    unknown = sorted(set(options or {}) - set(defaults))
+    if unknown:
+        raise ModelError(f"{kind} sweep: unknown option(s) {', '.join(unknown)} (allowed: {', '.join(defaults)})")
+    return {**defaults, **(options or {})}
 
 
 @dataclass(frozen=True)
@@ -44,13 +59,19 @@ class Task:
         simulate: ``output_points`` (int, output grid of a run; None: the scene's), ``rtol``,
         ``atol``, ``native`` (bool). optimize: ``intervals``, ``degree``, ``t_max`` [s] (None: each
         point's own baseline lock time), ``weights``, ``warm_start`` (bool, default True),
-        ``verify`` (bool, default True: replay each optimum with IDAS).
+        ``verify`` (bool, default True: replay each optimum with IDAS). Missing options take the
+        defaults of :data:`DEFAULT_OPTIONS`.
     """
 
     scene: str
     kind: str = "simulate"
     base_overrides: dict = field(default_factory=dict)
     options: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.kind not in TASKS:
+            raise ModelError(f"--task {self.kind!r}: allowed values are {', '.join(TASKS)}")
+        object.__setattr__(self, "options", task_options(self.kind, self.options))
 
     def columns(self):
         """Result columns of this task (without the parameter and status columns)."""
@@ -98,20 +119,26 @@ def run_unit(task, points):
 
 def simulate_point(task, point):
     """Simulate one point; returns ``(row, None)``."""
+    from ..engagement.model import EngagementModel
     from ..engagement.run import simulate_engagement
+    from ..simulation.native import compiler
 
     opts = task.options
+    native = bool(opts["native"]) and compiler() is not None     # no compiler: the VM, silently
     start = time.perf_counter()
     try:
         scene = point_scene(task, point)
-        run = simulate_engagement(scene, rtol=opts.get("rtol"), atol=opts.get("atol"),
-                                  output_points=opts.get("output_points"), native=bool(opts.get("native", False)))
+        model = EngagementModel(scene)
+        built = time.perf_counter()
+        run = simulate_engagement(scene, model=model, rtol=opts["rtol"], atol=opts["atol"],
+                                  output_points=opts["output_points"], native=native)
     except Exception as exc:                  # a failed point is recorded, never stops the sweep
         return _row(point, "failed", reason_of(exc), {"run_time_s": time.perf_counter() - start}), None
     s = run.summary
-    numbers = {key: s[key] for key in SIMULATE_COLUMNS if key in s}
-    numbers["n_steps"] = int(s["solver"]["statistics"]["n_steps"])
-    numbers["run_time_s"] = time.perf_counter() - start
+    numbers = {key: s[key] for key in SIMULATE_RESULTS}
+    numbers.update(n_steps=int(s["solver"]["statistics"]["n_steps"]), build_time_s=built - start,
+                   integration_time_s=float(s["solver"]["statistics"]["integration_time_s"]),
+                   run_time_s=time.perf_counter() - start)
     return _row(point, "ok", "", numbers), None
 
 
@@ -122,7 +149,7 @@ def optimize_chain(task, points):
     for point in points:
         row, curve, optimum = optimize_point(task, point, guess=previous)
         out.append((row, curve))
-        if task.options.get("warm_start", True):
+        if task.options["warm_start"]:
             previous = optimum if optimum is not None else previous
     return out
 
@@ -136,16 +163,16 @@ def optimize_point(task, point, guess=None):
     start = time.perf_counter()
     try:
         scene = point_scene(task, point)
-        ocp = EngagementOCP(scene, intervals=opts.get("intervals", 40), degree=opts.get("degree", 3))
+        ocp = EngagementOCP(scene, intervals=opts["intervals"], degree=opts["degree"])
         built = time.perf_counter()
-        optimum = ocp.solve(t_max=opts.get("t_max"), weights=opts.get("weights"), guess=guess)
+        optimum = ocp.solve(t_max=opts["t_max"], weights=opts["weights"], guess=guess)
         numbers = {key: optimum.terms[key] for key in ("engagement_time_s", "jerk_integral", "dissipated_energy_J",
                                                        "lockup_torque_jump_Nm", "peak_jerk_rad_s3", "peak_torque_Nm",
                                                        "objective")}
         numbers.update(t_max_s=float(optimum.t_max), ipopt_iterations=int(optimum.stats["iterations"]),
                        solve_time_s=float(optimum.stats["wall_time_s"]), build_time_s=built - start,
                        warm_start=bool(optimum.stats["warm_start"]))
-        if opts.get("verify", True):
+        if opts["verify"]:
             check, _ = verify(ocp.exact if ocp.polish else ocp, optimum)
             numbers["idas_lock_time_rel_diff"] = check["lock_time_rel_diff"]
     except Exception as exc:                  # a failed point is recorded, never stops the sweep

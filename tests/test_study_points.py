@@ -59,14 +59,13 @@ def test_grid_is_full_and_consecutive_points_are_neighbours(sizes):
         assert sorted(steps) == [0.0] * (len(axes) - 1) + [1.0]                # one field, one step
 
 
-def test_chains_follow_the_fastest_field():
-    axes = [("a.x", [0.0, 1.0, 2.0]), ("b.y", [10.0, 20.0])]
-    points = grid_points(axes)
-    runs = chains(points, ["a.x", "b.y"])
-    assert [len(r) for r in runs] == [2, 2, 2]
-    assert [p["b.y"] for p in runs[1]] == [20.0, 10.0]                          # serpentine: starts where the last ended
-    assert sum(runs, []) == points
-    assert chains(points[:3], ["a.x"]) == [points[:3]]
+@pytest.mark.parametrize("n_points, n_chains, lengths", [(6, 2, [3, 3]), (7, 3, [2, 3, 2]), (2, 4, [1, 1]),
+                                                        (5, 1, [5])])
+def test_chains_are_contiguous_paths_of_near_equal_length(n_points, n_chains, lengths):
+    points = grid_points([("a.x", [float(v) for v in range(n_points)])])
+    runs = chains(points, n_chains)
+    assert [len(r) for r in runs] == lengths
+    assert sum(runs, []) == points                    # in order: each run a path of neighbours
 
 
 def test_point_names_depend_on_values_not_on_order():

@@ -91,22 +91,16 @@ def grid_points(axes):
     return points
 
 
-def chains(points, fields):
-    """Split points (in :func:`grid_points` order) into runs along the last field.
+def chains(points, n_chains):
+    """Split points (in :func:`grid_points` order) into ``n_chains`` contiguous runs of near-equal length.
 
-    Each chain is a row of the grid along the fastest field: the unit of work of an optimize
-    sweep, solved in order on one worker so that each point warm-starts the next.
+    Consecutive grid points are neighbours, so every run is a path through the grid: the unit of
+    work of an optimize sweep, solved in order on one worker so that each point warm-starts the
+    next. Only the first point of each run starts cold (give one run per worker).
     """
-    if not fields or len(fields) == 1:
-        return [points] if points else []
-    head = fields[:-1]
-    out = []
-    for point in points:
-        if out and all(out[-1][-1][f] == point[f] for f in head):
-            out[-1].append(point)
-        else:
-            out.append([point])
-    return out
+    n = max(1, min(int(n_chains), len(points)))
+    bounds = [round(k * len(points) / n) for k in range(n + 1)]
+    return [points[a:b] for a, b in zip(bounds, bounds[1:]) if b > a]
 
 
 def point_id(point):

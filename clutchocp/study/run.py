@@ -9,7 +9,7 @@ from ..errors import ModelError
 from ..output import write_summary
 from ..scene import load_scene
 from ..simulation.native import native_status
-from .executor import check_engine, execute
+from .executor import check_engine, default_workers, execute
 from .figures import draw_study
 from .folder import StudyFolder
 from .points import StudySpecError, chains, grid_points, parse_grid, point_id
@@ -100,8 +100,8 @@ def run_sweep(scene, out_dir, *, task="simulate", grid=(), samples=None, seed=0,
     with StudyFolder(out, spec, columns) as folder:
         done = {row["point_id"] for row in folder.finished()}
         todo = [p for p in points if point_id(p) not in done]
-        if task == "optimize" and grid:
-            units = chains(todo, fields)
+        if task == "optimize" and grid:             # one path through the grid per worker: warm starts
+            units = chains(todo, 1 if engine == "serial" else workers or default_workers())
         else:
             units = [[p] for p in todo]
 

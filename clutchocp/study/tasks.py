@@ -14,7 +14,7 @@ import functools
 import time
 from dataclasses import asdict, dataclass, field
 
-from ..errors import ClutchocpError, ModelError
+from ..errors import ClutchocpError, ModelError, SolverError
 from .points import point_id
 
 TASKS = ("simulate", "optimize")
@@ -165,7 +165,13 @@ def optimize_point(task, point, guess=None):
         scene = point_scene(task, point)
         ocp = EngagementOCP(scene, intervals=opts["intervals"], degree=opts["degree"])
         built = time.perf_counter()
-        optimum = ocp.solve(t_max=opts["t_max"], weights=opts["weights"], guess=guess)
+        try:
+            optimum = ocp.solve(t_max=opts["t_max"], weights=opts["weights"], guess=guess)
+        except SolverError:
+            if guess is None:
+                raise
+            # a neighbour's optimum too far off to start from: solve this point cold
+            optimum = ocp.solve(t_max=opts["t_max"], weights=opts["weights"])
         numbers = {key: optimum.terms[key] for key in ("engagement_time_s", "jerk_integral", "dissipated_energy_J",
                                                        "lockup_torque_jump_Nm", "peak_jerk_rad_s3", "peak_torque_Nm",
                                                        "objective")}

@@ -19,8 +19,13 @@ PLOTTED = {
 SUFFIX_UNITS = (("_rad_s3", "rad/s^3"), ("_Nm", "N m"), ("_J", "J"), ("_Pa", "Pa"), ("_s", "s"))
 
 
+NAMED_UNITS = {"jerk_integral": "rad^2/s^5", "objective": "-", "energy_balance_rel_error": "-"}
+
+
 def result_label(column):
     """``"peak_torque_Nm"`` -> ``"peak torque [N m]"``."""
+    if column in NAMED_UNITS:
+        return f"{column.replace('_', ' ')} [{NAMED_UNITS[column]}]"
     for suffix, unit in SUFFIX_UNITS:
         if column.endswith(suffix):
             return f"{column[: -len(suffix)].replace('_', ' ')} [{unit}]"
@@ -187,6 +192,8 @@ def _curves(out, scene, task, rows, fields):
     ax.set_xlabel("time [s]")
     ax.set_ylabel("optimal pressure command [MPa]")
     ax.grid(True, alpha=0.3)
-    ax.set_title(f"{scene.name}: optimal engagement pressure per operating point ({len(by_point)} curves, "
-                 "each to its own lock-up)", fontsize=10)
+    t_max = task.options.get("t_max")
+    limit = f"t_max = {t_max:g} s" if t_max else "t_max = each point's own baseline lock-up time"
+    fig.suptitle(f"{scene.name}: optimal engagement pressure, {len(by_point)} operating points\n"
+                 f"each curve ends at its lock-up; {limit}", fontsize=10)
     return save_figure(fig, out / "optimal_curves.png")

@@ -14,7 +14,8 @@ Numbers (written to ``bench_sweep.json`` and printed):
 * ``runs_per_second_per_core``: points per second per worker of the 2-worker local sweep.
 * ``outside_integrator_share``: per engagement scene, the share of a sweep point's time spent
   outside the IDAS calls (model build, compilation, event checks, outputs, summary) for a new
-  point (every point of a sweep is a new model), and for a re-run of a built model; target <= 0.15.
+  point (every point of a sweep is a new model), and for a re-run of a built model; target <= 0.15;
+  again with 200 output times per run instead of the scene's (``..._200_output_points``).
 * ``optimize_map``: a default_driveline optimize map (``--map`` x ``--map`` points, load torque x
   oil viscosity) with warm starts along each grid row against the same points solved cold, on
   one process each; ``warm_over_cold`` of the wall time and of the IPOPT time; target <= 0.40.
@@ -79,8 +80,9 @@ def parallel(work, points):
     return out
 
 
-def outside_share(scene_name, repeats=3):
-    """Share of a point's time outside the IDAS calls: new model per point, and a re-run of one model."""
+def outside_share(scene_name, repeats=3, output_points=None):
+    """Share of a point's time outside the IDAS calls: new model per point, and a re-run of one model
+    (``output_points``: output grid of the runs, default the scene's)."""
     base = load_scene(scene_name)
     fresh, warm = [], []
     for k in range(repeats):
@@ -88,11 +90,11 @@ def outside_share(scene_name, repeats=3):
         start = time.perf_counter()
         model = EngagementModel(scene)
         built = time.perf_counter()
-        run = simulate_engagement(scene, model=model)
+        run = simulate_engagement(scene, model=model, output_points=output_points)
         total = time.perf_counter() - start
         fresh.append((total, built - start, run.result.stats["integration_time_s"]))
         start = time.perf_counter()
-        run = simulate_engagement(scene, model=model)
+        run = simulate_engagement(scene, model=model, output_points=output_points)
         warm.append((time.perf_counter() - start, run.result.stats["integration_time_s"]))
     total, build, integ = (statistics.median(v) for v in zip(*fresh))
     wtotal, winteg = (statistics.median(v) for v in zip(*warm))
@@ -138,9 +140,11 @@ def main(argv=None):
             result["parallel"] = parallel(work, args.points)
             print(json.dumps(result["parallel"], indent=1), file=sys.stderr)
         if "share" not in skip:
-            result["outside_integrator_share"] = {s: outside_share(s) for s in ("zhang2021", "bao2020",
-                                                                                   "default_driveline")}
-            print(json.dumps(result["outside_integrator_share"], indent=1), file=sys.stderr)
+            scenes = ("zhang2021", "bao2020", "default_driveline")
+            result["outside_integrator_share"] = {s: outside_share(s) for s in scenes}
+            result["outside_integrator_share_200_output_points"] = {s: outside_share(s, output_points=200)
+                                                                   for s in scenes}
+            print(json.dumps(result["outside_integrator_share_200_output_points"], indent=1), file=sys.stderr)
         if "optimize" not in skip:
             result["optimize_map"] = optimize_map(work, args.map)
             print(json.dumps(result["optimize_map"], indent=1), file=sys.stderr)

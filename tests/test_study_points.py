@@ -142,3 +142,18 @@ def test_rows_are_complete_on_disk_at_once_and_a_cut_line_is_dropped(tmp_path):
         folder.append(dict(rows[0], point_id="c3"))
         assert [r["point_id"] for r in folder.finished()] == ["a1", "b2", "c3"]
     assert json.loads((tmp_path / "s" / "study.json").read_text()) == SPEC
+
+
+def test_on_resume_calibration_rows_of_a_point_without_its_results_row_are_dropped(tmp_path):
+    row = {"oil.viscosity": 0.02, "point_id": "a1", "status": "ok", "reason": "", "engagement_time_s": 0.25}
+    curve = {"time_s": [0.0, 0.1, 0.2], "pressure_Pa": [0.0, 5e5, 1e6]}
+    with StudyFolder(tmp_path / "s", SPEC, COLUMNS) as folder:
+        folder.append_curve(row, curve, ["oil.viscosity"])
+        folder.append(row)
+        folder.append_curve(dict(row, point_id="b2", **{"oil.viscosity": 0.04}), curve, ["oil.viscosity"])
+        # interrupted here: b2's curve is written, its results row is not
+    with StudyFolder(tmp_path / "s", SPEC, COLUMNS) as folder:
+        assert [r["point_id"] for r in folder.finished()] == ["a1"]
+    lines = (tmp_path / "s" / "calibration.csv").read_text().splitlines()
+    assert lines == ["oil.viscosity,point_id,time_s,pressure_Pa", "0.02,a1,0.0,0.0", "0.02,a1,0.1,500000.0",
+                     "0.02,a1,0.2,1000000.0"]

@@ -29,10 +29,15 @@ def read_rows(folder):
                 for r in csv.DictReader(fh)]
 
 
-def cli(*args, **kw):
+def _default_sigint():
+    # a test run started in the background of a shell ignores SIGINT, and a child inherits that
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def cli(*args):
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     return subprocess.Popen([sys.executable, "-m", "clutchocp.cli", *args], cwd=ROOT, env=env, text=True,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, **kw)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_default_sigint)
 
 
 def test_a_four_point_sweep_on_two_workers_equals_four_single_runs(tmp_path):
@@ -89,7 +94,8 @@ def test_ctrl_c_stops_cleanly_and_the_same_command_resumes_without_recomputing(t
     assert 1 <= len(kept) < 20 and not (out / LOCK).exists()
     assert not (out / "summary.json").exists()
 
-    summary = run_sweep("zhang2021", out, grid=args[3:4], engine="serial", progress=False)  # engine: not part of the study
+    # the same sweep on another engine: the engine is not part of the study
+    summary = run_sweep("zhang2021", out, grid=args[3:4], engine="serial", progress=False)
     assert (summary["points_resumed"], summary["points_computed"]) == (len(kept), 20 - len(kept))
     rows = read_rows(out)
     assert len(rows) == 20 and len({r["point_id"] for r in rows}) == 20
@@ -139,13 +145,15 @@ def test_an_optimize_chain_warm_starts_and_finds_the_cold_optimum(tmp_path):
     assert [r["warm_start"] for r in rows] == [False, True]
     scene = load_scene("default_driveline", overrides={"load.torque": rows[1]["load.torque"]})
     cold = EngagementOCP(scene, intervals=12).solve()
-    assert rows[1]["objective"] == pytest.approx(cold.objective, rel=1e-6)
-    assert rows[1]["engagement_time_s"] == pytest.approx(cold.t_f, rel=1e-6)
+    # the same optimum (measured: warm and cold agree to 1e-14; IPOPT's tolerance allows more)
+    assert rows[1]["objective"] == pytest.approx(cold.objective, rel=1e-8)
+    assert rows[1]["engagement_time_s"] == pytest.approx(cold.t_f, rel=1e-8)
     with (tmp_path / "s" / CALIBRATION).open(newline="") as fh:
         table = list(csv.DictReader(fh))
     assert list(table[0]) == ["load.torque", "point_id", "time_s", "pressure_Pa"]
     mine = [r for r in table if r["point_id"] == rows[1]["point_id"]]
-    assert [float(r["pressure_Pa"]) for r in mine] == pytest.approx(list(cold.command), rel=1e-5, abs=1e-3 * cold.command.max())
+    assert [float(r["pressure_Pa"]) for r in mine] == pytest.approx(list(cold.command), rel=0,
+                                                                     abs=1e-8 * cold.command.max())
     assert (tmp_path / "s" / "optimal_curves.png").is_file() and (tmp_path / "s" / "sweep_lines.png").is_file()
 
 

@@ -147,8 +147,9 @@ class StudyFolder:
             return
         others = [p.name for p in self.path.iterdir() if p.name != LOCK]
         if others:
-            raise StudyFolderError(f"--out {self.path}: is not empty and holds no sweep ({', '.join(sorted(others)[:3])}"
-                                   f"{' ...' if len(others) > 3 else ''}); choose an empty or new folder")
+            listed = ", ".join(sorted(others)[:3]) + (" ..." if len(others) > 3 else "")
+            raise StudyFolderError(f"--out {self.path}: is not empty and holds no sweep ({listed}); "
+                                   "choose an empty or new folder")
         spec_file.write_text(json.dumps(self.spec, indent=2, sort_keys=True) + "\n", encoding="utf-8")
 
     # -- results ----------------------------------------------------------------------------------
@@ -182,7 +183,8 @@ class StudyFolder:
             self._calibration = _open_append(self.path / CALIBRATION, header)
         writer = csv.writer(self._calibration, lineterminator="\n")
         for t, p in zip(curve["time_s"], curve["pressure_Pa"]):
-            writer.writerow([format_cell(row.get(f)) for f in fields] + [row["point_id"], format_cell(t), format_cell(p)])
+            cells = [format_cell(row.get(f)) for f in fields] + [row["point_id"], format_cell(t), format_cell(p)]
+            writer.writerow(cells)
         self._calibration.flush()
 
 

@@ -217,7 +217,8 @@ def build_parser():
     p.add_argument("--output-points", type=int, default=None,
                    help="simulate: output times per run (default: the scene's simulation.output_points)")
     p.add_argument("--native", action="store_true",
-                   help="simulate: compile each point's equations to C (pays off only for long runs)")
+                   help="simulate: compile each point's equations to C (1-4 s per point; pays off only "
+                        "for runs much longer than that)")
     p.add_argument("--t-max", type=float, default=None,
                    help="optimize: largest engagement time [s] (default: each point's own baseline lock-up time)")
     p.add_argument("--weights", default=None, metavar="NAME=W,...", help="optimize: objective weights")

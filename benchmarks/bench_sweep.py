@@ -15,7 +15,9 @@ Numbers (written to ``bench_sweep.json`` and printed):
 * ``outside_integrator_share``: per engagement scene, the share of a sweep point's time spent
   outside the IDAS calls (model build, compilation, event checks, outputs, summary) for a new
   point (every point of a sweep is a new model), and for a re-run of a built model; target <= 0.15;
-  again with 200 output times per run instead of the scene's (``..._200_output_points``).
+  again with 200 output times per run instead of the scene's (``..._200_output_points``);
+  ``new_point_breakdown``: where a new point's time goes (profiled: model assembly, mode
+  compilation, integrator construction, integrator calls, outputs and event checks, summary).
 * ``optimize_map``: a default_driveline optimize map (``--map`` x ``--map`` points, load torque x
   oil viscosity) with warm starts along each grid row against the same points solved cold, on
   one process each; ``warm_over_cold`` of the wall time and of the IPOPT time; target <= 0.40.
@@ -103,6 +105,41 @@ def outside_share(scene_name, repeats=3, output_points=None):
             "rerun_share": 1 - winteg / wtotal}
 
 
+def _parts():
+    """Where a new point's time goes: (label, function) of the profiled calls."""
+    from clutchocp.engagement.run import summarize
+    from clutchocp.simulation.compiled import ColumnFunction, CompiledMode
+    from clutchocp.simulation.idas_path import IdasPath
+
+    return (("model assembly", EngagementModel.__init__), ("mode compilation", CompiledMode.__init__),
+            ("event-slope functions", CompiledMode.event_slopes), ("integrator construction", IdasPath._integrator),
+            ("integrator calls", IdasPath._run), ("outputs and event checks on the grid", ColumnFunction.__call__),
+            ("summary", summarize))
+
+
+def breakdown(scene_name):
+    """Seconds of each part of one new point (cProfile, cumulative time of each function; the
+    profiler itself slows the run, ``total_s``, by tens of per cent)."""
+    import cProfile
+    import pstats
+
+    base = load_scene(scene_name)
+    simulate_engagement(base)                          # imports and first-use caches outside the profile
+    scene = base.with_overrides({"oil.viscosity": base.value("oil.viscosity") * 1.037})
+    profile = cProfile.Profile()
+    start = time.perf_counter()
+    profile.enable()
+    simulate_engagement(scene)
+    profile.disable()
+    total = time.perf_counter() - start
+    stats = pstats.Stats(profile).stats
+    out = {"total_s": total}
+    for label, function in _parts():
+        code = function.__code__
+        out[label] = sum(v[3] for key, v in stats.items() if key == (code.co_filename, code.co_firstlineno, code.co_name))
+    return out
+
+
 def optimize_map(work, n):
     grid = [f"load.torque=80:120:{n}", f"oil.viscosity=0.05:0.09:{n}"]
     common = dict(scene="default_driveline", task="optimize", grid=grid, engine="serial")
@@ -144,7 +181,8 @@ def main(argv=None):
             result["outside_integrator_share"] = {s: outside_share(s) for s in scenes}
             result["outside_integrator_share_200_output_points"] = {s: outside_share(s, output_points=200)
                                                                    for s in scenes}
-            print(json.dumps(result["outside_integrator_share_200_output_points"], indent=1), file=sys.stderr)
+            result["new_point_breakdown"] = {s: breakdown(s) for s in scenes}
+            print(json.dumps(result["new_point_breakdown"], indent=1), file=sys.stderr)
         if "optimize" not in skip:
             result["optimize_map"] = optimize_map(work, args.map)
             print(json.dumps(result["optimize_map"], indent=1), file=sys.stderr)

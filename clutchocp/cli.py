@@ -127,7 +127,8 @@ def _cmd_sweep(args):
     if args.task == "simulate":
         if args.output_points is not None and args.output_points < 2:
             raise ModelError(f"--output-points {args.output_points}: must be >= 2")
-        options.update(native=args.native, output_points=args.output_points)
+        options.update(native={"auto": "auto", "on": True, "off": False}[args.native],
+                       output_points=args.output_points, reuse_model=not args.model_per_point)
     else:
         options.update(intervals=args.intervals, degree=args.degree, t_max=args.t_max,
                        weights=_parse_weights(args.weights) if args.weights else None,
@@ -216,9 +217,12 @@ def build_parser():
                    help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (implies --engine dask)")
     p.add_argument("--output-points", type=int, default=None,
                    help="simulate: output times per run (default: the scene's simulation.output_points)")
-    p.add_argument("--native", action="store_true",
-                   help="simulate: compile each point's equations to C (1-4 s per point; pays off only "
-                        "for runs much longer than that)")
+    p.add_argument("--model-per-point", action="store_true",
+                   help="simulate: build a new model at every point (the single-run results bit for bit; "
+                        "default: one model per worker with the swept fields as parameters, where possible)")
+    p.add_argument("--native", default="auto", choices=("auto", "on", "off"),
+                   help="simulate: compiled C code: auto (default) for a model reused over the points, where "
+                        "a C compiler exists; on: also for one model per point (1-4 s each); off: never")
     p.add_argument("--t-max", type=float, default=None,
                    help="optimize: largest engagement time [s] (default: each point's own baseline lock-up time)")
     p.add_argument("--weights", default=None, metavar="NAME=W,...", help="optimize: objective weights")

@@ -15,6 +15,7 @@ from clutchocp.cli import main
 from clutchocp.engagement.run import simulate_engagement
 from clutchocp.optimal.problem import EngagementOCP
 from clutchocp.scene import load_scene
+from clutchocp.simulation.native import compiler
 from clutchocp.study import run_sweep
 from clutchocp.study.folder import CALIBRATION, LOCK, RESULTS, parse_cell
 from clutchocp.study.tasks import SIMULATE_COLUMNS, SIMULATE_RESULTS
@@ -40,21 +41,54 @@ def cli(*args):
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_default_sigint)
 
 
-def test_a_four_point_sweep_on_two_workers_equals_four_single_runs(tmp_path):
-    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID_2x2, engine="local", workers=2, progress=False)
+@pytest.fixture(scope="module")
+def single_runs():
+    """The four points of GRID_2x2 run one by one with the Python API: {(pressure, viscosity): summary}."""
+    base = load_scene("zhang2021")
+    return {(p, v): simulate_engagement(base.with_overrides({"actuation.pressure": p, "oil.viscosity": v})).summary
+            for p in (4e5, 8e5) for v in (0.04, 0.06)}
+
+
+def test_a_four_point_sweep_on_two_workers_equals_four_single_runs(tmp_path, single_runs):
+    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID_2x2, engine="local", workers=2, progress=False,
+                        options={"reuse_model": False})
     assert (summary["points"], summary["points_ok"], summary["engine"]["workers"]) == (4, 4, 2)
     rows = read_rows(tmp_path / "s")
     assert len(rows) == 4
-    base = load_scene("zhang2021")
     for row in rows:
-        point = {"actuation.pressure": row["actuation.pressure"], "oil.viscosity": row["oil.viscosity"]}
-        single = simulate_engagement(base.with_overrides(point)).summary
+        single = single_runs[row["actuation.pressure"], row["oil.viscosity"]]
         for key in SIMULATE_RESULTS:
             assert row[key] == single[key], key                 # exactly: same equations, same steps
         assert row["n_steps"] == single["solver"]["statistics"]["n_steps"]
-        assert row["final_mode"] == single["final_mode"]
+        assert row["model_reused"] is False and row["native_code"] is False
     assert (tmp_path / "s" / "sweep_maps.png").is_file() and (tmp_path / "s" / "summary.json").is_file()
     assert not (tmp_path / "s" / LOCK).exists()
+
+
+def test_by_default_one_model_serves_every_point_and_agrees_with_the_single_runs(tmp_path, single_runs):
+    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID_2x2, engine="serial", progress=False)
+    rows = read_rows(tmp_path / "s")
+    assert summary["points_model_reused"] == 4 and all(r["model_reused"] for r in rows)
+    assert summary["native_code"]["used"] == (compiler() is not None)
+    for row in rows:
+        single = single_runs[row["actuation.pressure"], row["oil.viscosity"]]
+        assert row["n_steps"] == single["solver"]["statistics"]["n_steps"]
+        assert row["final_mode"] == single["final_mode"]
+        for key in SIMULATE_RESULTS[:-1]:
+            # the same equations with the values as parameters (constants folded in another order;
+            # measured: 1e-14 relative); compiled C or CasADi's virtual machine
+            assert row[key] == pytest.approx(single[key], rel=1e-9, abs=1e-9 * abs(single["peak_torque_Nm"])), key
+    assert rows[0]["build_time_s"] == 0.0
+
+
+def test_a_field_that_cannot_be_a_parameter_falls_back_to_one_model_per_point(tmp_path):
+    # the input speed sets the initial state and its scale: the model needs it as a number
+    run_sweep("default_driveline", tmp_path / "s", grid=["driveline.input_speed=280:320:2"], engine="serial",
+              progress=False, options={"native": False})
+    rows = read_rows(tmp_path / "s")
+    scene = load_scene("default_driveline", overrides={"driveline.input_speed": 320.0})
+    assert [r["model_reused"] for r in rows] == [False, False]
+    assert rows[1]["engagement_time_s"] == simulate_engagement(scene).summary["engagement_time_s"]
 
 
 def test_a_failing_point_is_recorded_with_its_reason_and_the_sweep_goes_on(tmp_path):
@@ -62,7 +96,7 @@ def test_a_failing_point_is_recorded_with_its_reason_and_the_sweep_goes_on(tmp_p
     # and IDAS fails; without permeability the run completes (tests/test_extreme.py, same case).
     smooth = {"contact.model": "none", "contact.E_equiv": None, "roughness.sigma": 0, "film.flow_factor": "none"}
     summary = run_sweep("zhang2021", tmp_path / "s", grid=["plates.lining_permeability=0:4e-12:3"],
-                        overrides=smooth, engine="serial", progress=False)
+                        overrides=smooth, engine="serial", progress=False, options={"native": False})
     rows = read_rows(tmp_path / "s")
     assert [r["status"] for r in rows] == ["ok", "failed", "failed"]
     for row in rows[1:]:
@@ -77,7 +111,8 @@ def test_a_failing_point_is_recorded_with_its_reason_and_the_sweep_goes_on(tmp_p
 
 def test_ctrl_c_stops_cleanly_and_the_same_command_resumes_without_recomputing(tmp_path):
     out = tmp_path / "s"
-    args = ["sweep", "zhang2021", "--grid", "oil.viscosity=0.04:0.08:20", "--out", str(out), "--workers", "2"]
+    args = ["sweep", "zhang2021", "--grid", "oil.viscosity=0.04:0.08:20", "--out", str(out), "--native", "off",
+            "--workers", "2"]
     proc = cli(*args)
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:
@@ -95,7 +130,8 @@ def test_ctrl_c_stops_cleanly_and_the_same_command_resumes_without_recomputing(t
     assert not (out / "summary.json").exists()
 
     # the same sweep on another engine: the engine is not part of the study
-    summary = run_sweep("zhang2021", out, grid=args[3:4], engine="serial", progress=False)
+    summary = run_sweep("zhang2021", out, grid=args[3:4], engine="serial", progress=False,
+                        options={"native": False})
     assert (summary["points_resumed"], summary["points_computed"]) == (len(kept), 20 - len(kept))
     rows = read_rows(out)
     assert len(rows) == 20 and len({r["point_id"] for r in rows}) == 20
@@ -162,7 +198,7 @@ def test_samples_are_the_seeded_draws_of_the_scene_uncertainty(tmp_path):
 
     extra = ("actuation.time_constant=uniform 25 %",)
     summary = run_sweep("zhang2021", tmp_path / "s", samples=3, seed=7, uncertain=extra, engine="serial",
-                        progress=False)
+                        progress=False, options={"native": False})
     draws = Uncertainty.from_scene(load_scene("zhang2021"), extra=extra).samples(3, seed=7)
     rows = read_rows(tmp_path / "s")
     assert [r["actuation.time_constant"] for r in rows] == [d["actuation.time_constant"] for d in draws]

@@ -32,7 +32,7 @@ class EngagementResult:
 
 
 def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=None, output_points=None,
-                        model=None, native=False, solver_options=None):
+                        model=None, native=False, solver_options=None, parameters=None):
     """Simulate an engagement scene through impact, slip and lock-up.
 
     Parameters
@@ -60,6 +60,9 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     solver_options : dict, optional
         Further :class:`~clutchocp.simulation.SimulationOptions` fields, e.g.
         ``{"max_wall_time": 10.0}`` (a wall-time cap [s]) or ``{"event_value_tol": 1e-10}``.
+    parameters : dict, optional
+        Values of the free parameters of ``model.hybrid`` (a model built with scene values as
+        CasADi symbols, :mod:`clutchocp.study.parametric`), SI.
 
     Returns
     -------
@@ -80,7 +83,8 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     x0 = dict(zip(model.state_names, model.initial_state))
     start = time.perf_counter()
     try:
-        result = simulate(model.hybrid, x0, grid, mode=model.initial_mode(), options=options, method=method)
+        result = simulate(model.hybrid, x0, grid, mode=model.initial_mode(), p=parameters, options=options,
+                          method=method)
     except SolverError as err:
         raise explain_failure(model, err) from None
     wall = time.perf_counter() - start

@@ -153,5 +153,7 @@ def sweep_summary(scene, task, fields, rows, *, resumed, computed, wall, engine_
         "wall_time_s": wall,
         "points_per_second": computed / wall if computed and wall > 0 else None,
         "points_per_second_per_worker": computed / wall / workers if computed and wall > 0 and workers else None,
-        "native_code": native_status(bool(task.options.get("native", False))) if task.kind == "simulate" else None,
+        "native_code": dict(native_status(task.options["native"] is not False), requested=task.options["native"],
+                            used=any(r.get("native_code") is True for r in ok)) if task.kind == "simulate" else None,
+        "points_model_reused": sum(r.get("model_reused") is True for r in ok) if task.kind == "simulate" else None,
     }

@@ -23,14 +23,15 @@ TASKS = ("simulate", "optimize")
 SIMULATE_RESULTS = ("engagement_time_s", "lockup_torque_jump_Nm", "peak_torque_Nm", "peak_jerk_rad_s3",
                     "dissipated_energy_J", "energy_balance_rel_error", "torque_response_time_s",
                     "pressure_response_time_s", "final_mode")
-SIMULATE_COLUMNS = SIMULATE_RESULTS + ("n_steps", "build_time_s", "integration_time_s", "run_time_s")
+SIMULATE_COLUMNS = SIMULATE_RESULTS + ("n_steps", "model_reused", "native_code", "build_time_s", "integration_time_s",
+                                       "run_time_s")
 OPTIMIZE_COLUMNS = ("engagement_time_s", "t_max_s", "jerk_integral", "dissipated_energy_J", "lockup_torque_jump_Nm",
                     "peak_jerk_rad_s3", "peak_torque_Nm", "objective", "ipopt_iterations", "solve_time_s",
                     "build_time_s", "warm_start", "idas_lock_time_rel_diff", "run_time_s")
 STATUS_COLUMNS = ("point_id", "status", "reason")
 # Options of each task with their defaults (see Task).
 DEFAULT_OPTIONS = {
-    "simulate": {"output_points": None, "rtol": None, "atol": None, "native": False},
+    "simulate": {"output_points": None, "rtol": None, "atol": None, "native": "auto", "reuse_model": True},
     "optimize": {"intervals": 40, "degree": 3, "t_max": None, "weights": None, "warm_start": True, "verify": True},
 }
 
@@ -57,7 +58,10 @@ class Task:
         ``{"part.key": value}`` applied to the scene before each point's own overrides (``--set``).
     options : dict
         simulate: ``output_points`` (int, output grid of a run; None: the scene's), ``rtol``,
-        ``atol``, ``native`` (bool). optimize: ``intervals``, ``degree``, ``t_max`` [s] (None: each
+        ``atol``, ``reuse_model`` (bool, default True: one model per worker with the swept fields
+        as parameters, :mod:`clutchocp.study.parametric`, where the model allows it; False: a new
+        model per point, bit for bit the single-run results), ``native`` (``"auto"``, default:
+        compiled C for a reused model where a C compiler exists; True: for every model; False: never). optimize: ``intervals``, ``degree``, ``t_max`` [s] (None: each
         point's own baseline lock time), ``weights``, ``warm_start`` (bool, default True),
         ``verify`` (bool, default True: replay each optimum with IDAS). Missing options take the
         defaults of :data:`DEFAULT_OPTIONS`.
@@ -124,22 +128,62 @@ def simulate_point(task, point):
     from ..simulation.native import compiler
 
     opts = task.options
-    native = bool(opts["native"]) and compiler() is not None     # no compiler: the VM, silently
+    has_compiler = compiler() is not None                       # no compiler: the VM, silently
+    settings = {"rtol": opts["rtol"], "atol": opts["atol"], "output_points": opts["output_points"]}
     start = time.perf_counter()
     try:
         scene = point_scene(task, point)
-        model = EngagementModel(scene)
-        built = time.perf_counter()
-        run = simulate_engagement(scene, model=model, rtol=opts["rtol"], atol=opts["atol"],
-                                  output_points=opts["output_points"], native=native)
+        native = has_compiler and opts["native"] in (True, "auto")
+        run = _simulate_reusing(task, point, scene, dict(settings, native=native)) if opts["reuse_model"] else None
+        reused = run is not None
+        built = start
+        if run is None:
+            native = has_compiler and opts["native"] is True
+            model = EngagementModel(scene)
+            built = time.perf_counter()
+            run = simulate_engagement(scene, model=model, native=native, **settings)
     except Exception as exc:                  # a failed point is recorded, never stops the sweep
         return _row(point, "failed", reason_of(exc), {"run_time_s": time.perf_counter() - start}), None
     s = run.summary
     numbers = {key: s[key] for key in SIMULATE_RESULTS}
-    numbers.update(n_steps=int(s["solver"]["statistics"]["n_steps"]), build_time_s=built - start,
+    numbers.update(n_steps=int(s["solver"]["statistics"]["n_steps"]), model_reused=reused, native_code=native,
+                   build_time_s=built - start,
                    integration_time_s=float(s["solver"]["statistics"]["integration_time_s"]),
                    run_time_s=time.perf_counter() - start)
     return _row(point, "ok", "", numbers), None
+
+
+_PARAMETRIC = {}        # this worker's parametric models: key -> [ParametricModel or None, checked]
+
+
+def _simulate_reusing(task, point, scene, settings):
+    """The run of ``point`` on this worker's parametric model, or None where it cannot be used
+    (a choice field, a field the model cannot take as a symbol, a run that fails: the usual run
+    then gives the result or the failure and its reason)."""
+    from ..engagement.run import simulate_engagement
+    from . import parametric
+
+    names = tuple(sorted(point))
+    if not all(isinstance(point[n], float) for n in names):
+        return None
+    key = (task.scene, tuple(sorted(task.base_overrides.items(), key=lambda kv: kv[0])), names)
+    entry = _PARAMETRIC.get(key)
+    if entry is None:
+        entry = _PARAMETRIC[key] = [parametric.build(point_scene(task, {}), names), False]
+    if entry[0] is None:
+        return None
+    view, values = entry[0].for_point(scene)
+    try:
+        run = simulate_engagement(scene, model=view, parameters=values, **settings)
+    except Exception:
+        return None
+    if not entry[1]:                          # the first point: check against the usual run once
+        reference = simulate_engagement(scene, **dict(settings, native=False))
+        if not parametric.agrees(run.summary, reference.summary):
+            entry[0] = None
+            return None
+        entry[1] = True
+    return run
 
 
 def optimize_chain(task, points):

@@ -9,10 +9,12 @@ as compiled code instead of CasADi's SX virtual machine: the same steps and resu
 named by the hash of their generated source (the model with all its numbers, and the compiler
 flags), so the same model is compiled once per machine and later processes load it.
 
-Scene values enter the equations as numbers, so every point of a sweep is a new model with its
-own hash: there compiling (1.6 s for a zhang2021 point, 4.4 s for bao2020, measured) costs far
-more than the whole run on CasADi's virtual machine (0.1-0.7 s), which is why native code stays
-opt-in (``SimulationOptions(native=True)``, ``clutchocp simulate --native``, ``sweep --native``).
+Scene values enter the equations as numbers, so a model built for one set of values has its own
+hash: compiling it (1.6 s for a zhang2021 point, 4.4 s for bao2020, measured) costs far more than
+its run on CasADi's virtual machine (0.2-1 s). Native code is therefore opt-in for single runs
+(``SimulationOptions(native=True)``, ``clutchocp simulate --native``) and the default of sweeps
+only for a model reused over all points (:mod:`clutchocp.study.parametric`), whose source does not
+depend on the swept values: compiled once per machine, then loaded.
 """
 
 import hashlib

@@ -3,6 +3,7 @@ per core, the share of a run spent outside the integrator calls, warm-started op
 
     PYTHONPATH=. python benchmarks/bench_sweep.py --out out/bench_sweep          # about 6 minutes
     PYTHONPATH=. python benchmarks/bench_sweep.py --points 40 --map 3            # a quick look
+    PYTHONPATH=. python benchmarks/bench_sweep.py --skip share,optimize --model-per-point  # heavier points
 
 Numbers (written to ``bench_sweep.json`` and printed):
 
@@ -73,15 +74,18 @@ def zhang_grid(points):
     return [f"actuation.pressure=0.4 MPa:0.8 MPa:{n_pressure}", f"oil.viscosity=0.04:0.08:{n_viscosity}"]
 
 
-def parallel(work, points):
+def parallel(work, points, options=None):
     grid = zhang_grid(points)
     out = {"points": None, "load_before": load()}
     # the compiled C of the sweep's model is built once per machine (disk cache): build it before timing
     warm = [f"{g.rsplit(':', 1)[0]}:2" for g in grid]
     out["native_first_build_s"] = timed_sweep(work, "warmup", scene="zhang2021", grid=warm, engine="serial")[0]
-    t1, s1, _ = timed_sweep(work, "local1", scene="zhang2021", grid=grid, engine="local", workers=1)
-    t2, s2, _ = timed_sweep(work, "local2", scene="zhang2021", grid=grid, engine="local", workers=2)
-    td, sd, _ = timed_sweep(work, "dask2", scene="zhang2021", grid=grid, engine="dask", workers=2)
+    t1, s1, _ = timed_sweep(work, "local1", scene="zhang2021", grid=grid, engine="local", workers=1,
+                               options=options)
+    t2, s2, _ = timed_sweep(work, "local2", scene="zhang2021", grid=grid, engine="local", workers=2,
+                               options=options)
+    td, sd, _ = timed_sweep(work, "dask2", scene="zhang2021", grid=grid, engine="dask", workers=2,
+                               options=options)
     out.update(points=s2["points"], local_1_worker_s=t1, local_2_workers_s=t2, dask_2_workers_s=td,
                parallel_efficiency=t1 / (2 * t2), dask_over_local=td / t2,
                runs_per_second_per_core=s2["points"] / t2 / 2, load_after=load())
@@ -187,6 +191,8 @@ def main(argv=None):
     parser.add_argument("--out", default="out/bench_sweep")
     parser.add_argument("--points", type=int, default=200, help="zhang2021 sweep points (default 200)")
     parser.add_argument("--map", type=int, default=5, help="optimize map size n (n x n points, default 5)")
+    parser.add_argument("--model-per-point", action="store_true",
+                        help="parallel part: a new model at every point (heavier points) instead of the default")
     parser.add_argument("--skip", default="", help="comma-separated parts to skip: parallel, share, optimize")
     args = parser.parse_args(argv)
     skip = set(filter(None, args.skip.split(",")))
@@ -196,7 +202,7 @@ def main(argv=None):
     result = {"cores": os.cpu_count(), "targets": TARGETS}
     try:
         if "parallel" not in skip:
-            result["parallel"] = parallel(work, args.points)
+            result["parallel"] = parallel(work, args.points, {"reuse_model": False} if args.model_per_point else None)
             print(json.dumps(result["parallel"], indent=1), file=sys.stderr)
         if "share" not in skip:
             scenes = ("zhang2021", "bao2020", "default_driveline")

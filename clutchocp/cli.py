@@ -83,6 +83,22 @@ def time_limit(text):
     return positive_float(text, what="a positive time in seconds")
 
 
+def nonnegative_time(text):
+    """A finite time >= 0 [s]; an argparse ``type=``."""
+    return 0.0 if text.strip() in ("0", "0.0") else positive_float(text, what="a time >= 0 in seconds")
+
+
+def temperature(text):
+    """A finite temperature above absolute zero [degC]; an argparse ``type=``."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number; a temperature in degC is allowed") from None
+    if not (math.isfinite(value) and value > -273.15):
+        raise argparse.ArgumentTypeError(f"{text}: a temperature in degC above -273.15 is allowed")
+    return value
+
+
 def parse_time_list(text, option):
     """``"0.2,0.3,0.4"`` or ``"0.2:0.5:7"`` (start:stop:count) -> sorted distinct positive times [s].
 
@@ -247,6 +263,39 @@ def _cmd_bench(args):
     return 0
 
 
+def _cmd_sweep(args):
+    from .scene import parse_override
+    from .study import StudyInterrupted, run_sweep
+
+    if args.scheduler and args.engine not in (None, "dask"):
+        raise ModelError(f"--scheduler {args.scheduler}: needs --engine dask (or no --engine)")
+    engine = args.engine or ("dask" if args.scheduler else "local")
+    options = {}
+    if args.task == "simulate":
+        if args.output_points is not None and args.output_points < 2:
+            raise ModelError(f"--output-points {args.output_points}: must be >= 2")
+        options.update(native={"auto": "auto", "on": True, "off": False}[args.native],
+                       output_points=args.output_points, reuse_model=not args.model_per_point)
+    else:
+        options.update(intervals=args.intervals, degree=args.degree, t_max=args.t_max,
+                       weights=parse_weights(args.weights) if args.weights is not None else None,
+                       warm_start=not args.cold, verify=not args.no_verify)
+    try:
+        summary = run_sweep(args.scene, args.out, task=args.task, grid=args.grid, samples=args.samples,
+                            seed=args.seed, uncertain=args.uncertain,
+                            overrides=dict(parse_override(text) for text in args.set), options=options,
+                            engine=engine, workers=args.workers, scheduler=args.scheduler, progress=True)
+    except StudyInterrupted as exc:
+        print(f"clutchocp sweep: {exc}", file=sys.stderr)
+        return 130
+    rate = summary["points_per_second"]
+    print(f"{summary['scene']} {summary['task']} sweep: {summary['points']} points, {summary['points_ok']} ok, "
+          f"{summary['points_failed']} failed, {summary['points_resumed']} resumed; "
+          f"{summary['wall_time_s']:.1f} s" + (f" ({rate:.2f} points/s)" if rate else ""))
+    print(f"wrote {args.out}: " + ", ".join(Path(f).name for f in summary["files"]) + ", results.csv")
+    return 0
+
+
 def build_parser():
     """The argument parser of the ``clutchocp`` command."""
     parser = _Parser(
@@ -277,10 +326,10 @@ def build_parser():
     p = sub.add_parser("cycles", help="repeated engagements with cooling between: temperature and engagement-time "
                                       "drift per cycle, until a limit (scene needs a [thermal] part)")
     p.add_argument("scene", help="engagement scene with a [thermal] part (e.g. default_driveline_thermal) or TOML file")
-    p.add_argument("--cycles", type=int, default=10, help="largest number of engagements (default: 10)")
-    p.add_argument("--cooling-time", type=float, default=10.0, metavar="S",
+    p.add_argument("--cycles", type=count(1, 10000, "engagements"), default=10, help="largest number of engagements (default: 10)")
+    p.add_argument("--cooling-time", type=nonnegative_time, default=10.0, metavar="S",
                    help="open-clutch cooling interval after each engagement run [s] (default: 10)")
-    p.add_argument("--max-temperature", type=float, default=None, metavar="DEGC",
+    p.add_argument("--max-temperature", type=temperature, default=None, metavar="DEGC",
                    help="stop after the cycle whose peak interface temperature reaches this [degC]")
     p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
                    help="override a scene value (repeatable)")
@@ -307,9 +356,9 @@ def build_parser():
                    help="collocation points per interval, 1 ... 9 (default: 3)")
     p.add_argument("--sweep-t-max", default=None, metavar="LIST|START:STOP:COUNT",
                    help="solve for several engagement-time limits and draw the jerk/time trade-off")
-    p.add_argument("--max-temperature", type=float, default=None, metavar="DEGC",
+    p.add_argument("--max-temperature", type=temperature, default=None, metavar="DEGC",
                    help="largest interface temperature [degC] while slipping (scene needs a [thermal] part)")
-    p.add_argument("--max-specific-power", type=float, default=None, metavar="W_MM2",
+    p.add_argument("--max-specific-power", type=positive_float, default=None, metavar="W_MM2",
                    help="largest interface heat power per friction area [W/mm^2] while slipping")
     p.set_defaults(run=_cmd_optimize)
     p = sub.add_parser("bench", help="error against run time, stiffness and scaling (work-precision report)")
@@ -325,16 +374,58 @@ def build_parser():
                                       "(baseline, nominal optimum, robust feedforward, slip feedback)")
     p.add_argument("scene", nargs="?", default=None, help="engagement scene (default: the default scene)")
     p.add_argument("--out", default="out/robust", help="output folder (default: out/robust)")
-    p.add_argument("--samples", type=int, default=200, help="draws of the uncertainty (default: 200)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the draws (default: 0)")
+    p.add_argument("--samples", type=count(1, 1_000_000, "samples"), default=200,
+                   help="draws of the uncertainty (default: 200)")
+    p.add_argument("--seed", type=count(0, 2**32 - 1, "seed"), default=0, help="seed of the draws (default: 0)")
     p.add_argument("--uncertain", action="append", default=[], metavar="PART.KEY=SPEC",
                    help="add or replace an uncertain field, e.g. --uncertain 'friction.mu=uniform 10 %%' (repeatable)")
-    p.add_argument("--t-max", type=float, default=None,
+    p.add_argument("--t-max", type=time_limit, default=None,
                    help="engagement-time limit [s] (default: lock-up time of the scene's own profile)")
     p.add_argument("--controller", default="slip_lqr", help="slip-feedback spec name or TOML file (default: slip_lqr)")
-    p.add_argument("--workers", type=int, default=None, help="parallel processes (default: the local cores)")
-    p.add_argument("--intervals", type=int, default=60, help="collocation intervals of the optimisations (default: 60)")
+    p.add_argument("--workers", type=count(1, 1024, "parallel processes"), default=None,
+                   help="parallel processes (default: the local cores)")
+    p.add_argument("--intervals", type=count(2, MAX_INTERVALS, "collocation intervals"), default=60, help="collocation intervals of the optimisations (default: 60)")
     p.set_defaults(run=_cmd_robust)
+    p = sub.add_parser("sweep", help="many runs of a scene: a grid of operating points or Monte Carlo samples, "
+                                     "on local processes or a Dask cluster")
+    p.add_argument("scene", help="engagement scene name or TOML file")
+    p.add_argument("--task", default="simulate", choices=("simulate", "optimize"),
+                   help="what to do at each point (default: simulate)")
+    p.add_argument("--grid", action="append", default=[], metavar="PART.KEY=START:STOP:COUNT",
+                   help="a swept field (SI numbers or quantities, e.g. load.torque=50:150:5); repeat for a full grid")
+    p.add_argument("--samples", type=count(1, 1_000_000, "samples"), default=None, metavar="N",
+                   help="N samples of the scene's [uncertainty] (and --uncertain fields)")
+    p.add_argument("--seed", type=count(0, 2**32 - 1, "seed"), default=0, help="seed of the samples (default: 0)")
+    p.add_argument("--uncertain", action="append", default=[], metavar="PART.KEY=DIST",
+                   help="an uncertain field, e.g. 'friction.mu=uniform 10 %%' (repeatable)")
+    p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
+                   help="override a scene value at every point (repeatable)")
+    p.add_argument("--out", default="out/sweep", help="output folder (default: out/sweep); a folder holding the "
+                                                      "same sweep is resumed")
+    p.add_argument("--engine", default=None, choices=("local", "dask", "serial"),
+                   help="local worker processes (default), dask (a LocalCluster, or --scheduler) or serial")
+    p.add_argument("--workers", type=count(1, 1024, "workers"), default=None,
+                   help="local or LocalCluster workers (default: all cores)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (implies --engine dask)")
+    p.add_argument("--output-points", type=count(2, 200_000, "output times per run"), default=None,
+                   help="simulate: output times per run (default: the scene's simulation.output_points)")
+    p.add_argument("--model-per-point", action="store_true",
+                   help="simulate: build a new model at every point (the single-run results bit for bit; "
+                        "default: one model per worker with the swept fields as parameters, where possible)")
+    p.add_argument("--native", default="auto", choices=("auto", "on", "off"),
+                   help="simulate: compiled C code: auto (default) for a model reused over the points, where "
+                        "a C compiler exists; on: also for one model per point (1-4 s each); off: never")
+    p.add_argument("--t-max", type=time_limit, default=None,
+                   help="optimize: largest engagement time [s] (default: each point's own baseline lock-up time)")
+    p.add_argument("--weights", default=None, metavar="NAME=W,...", help="optimize: objective weights")
+    p.add_argument("--intervals", type=count(2, MAX_INTERVALS, "collocation intervals"), default=40,
+                   help="optimize: collocation intervals (default: 40)")
+    p.add_argument("--degree", type=count(1, 9, "collocation points per interval"), default=3,
+                   help="optimize: collocation points per interval (default: 3)")
+    p.add_argument("--cold", action="store_true", help="optimize: no warm start from the neighbouring point")
+    p.add_argument("--no-verify", action="store_true", help="optimize: skip the IDAS replay of each optimum")
+    p.set_defaults(run=_cmd_sweep)
     return parser
 
 

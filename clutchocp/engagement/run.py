@@ -87,7 +87,7 @@ class EngagementResult:
 
 
 def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=None, output_points=None,
-                        model=None, native=False, solver_options=None, initial_state=None):
+                        model=None, native=False, solver_options=None, initial_state=None, parameters=None):
     """Simulate an engagement scene through impact, slip and lock-up.
 
     Parameters
@@ -118,6 +118,9 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     initial_state : dict, optional
         ``{state name: value}`` replacing the scene's initial values (e.g. the plate temperatures
         ``T_friction``, ``T_separator`` [degC] of a repeated engagement).
+    parameters : dict, optional
+        Values of the free parameters of ``model.hybrid`` (a model built with scene values as
+        CasADi symbols, :mod:`clutchocp.study.parametric`), SI.
 
     Returns
     -------
@@ -146,7 +149,8 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
         x0[name] = float(value)
     start = time.perf_counter()
     try:
-        result = simulate(model.hybrid, x0, grid, mode=model.initial_mode(), options=options, method=method)
+        result = simulate(model.hybrid, x0, grid, mode=model.initial_mode(), p=parameters, options=options,
+                          method=method)
     except SolverError as err:
         raise explain_failure(model, err) from None
     wall = time.perf_counter() - start

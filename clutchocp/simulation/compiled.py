@@ -8,6 +8,7 @@ parts repeats many terms (e.g. a contact force feeds the film load, the torque, 
 and the energy rates), and the shared form halves the cost of the right-hand side.
 """
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import casadi as ca
@@ -58,7 +59,16 @@ class ColumnFunction:
         self.n_out = function.size1_out(0)
         self._maps = {}
         self._max_maps = max_maps
-        self._numpy = numpy_function(function)     # many samples: one numpy operation per instruction
+        self._numpy_built = False
+        self._numpy_fn = None
+
+    @property
+    def _numpy(self):
+        """The numpy translation (many samples: one numpy operation per instruction), made on first
+        use: a run whose output pieces all have fewer than MIN_SAMPLES samples never pays for it."""
+        if not self._numpy_built:
+            self._numpy_fn, self._numpy_built = numpy_function(self.function), True
+        return self._numpy_fn
 
     def _map(self, n):
         entry = self._maps.pop(n, None)
@@ -75,7 +85,7 @@ class ColumnFunction:
         t = np.atleast_1d(np.asarray(t, float)).ravel()
         n = t.size
         nx, nz = self.sizes[:2]
-        if self._numpy is not None and n >= MIN_SAMPLES:
+        if n >= MIN_SAMPLES and self._numpy is not None:
             out = np.empty((self.n_out, n))
             with np.errstate(all="ignore"):       # as CasADi: NaN/inf where the expression gives them
                 self._numpy([np.reshape(np.asarray(xs, float), (nx, n)), np.reshape(np.asarray(zs, float), (nz, n)),
@@ -158,26 +168,19 @@ class CompiledMode:
         self._native_outputs_on = None
         self.integrators = {}       # cached casadi integrators of this mode (see idas_path)
 
-    def build_resets(self, compiled):
-        """Reset maps x+ (scaled for the target mode) of every event; needs all modes compiled."""
+    def build_resets(self, modes):
+        """Reset maps x+ (scaled for the target mode) of every event.
+
+        Parameters
+        ----------
+        modes : dict
+            All :class:`~clutchocp.simulation.model.Mode` objects of the model by name.
+        """
         mode = self._mode
         self.resets = []
         for ev in mode.events:
-            target = compiled[ev.target]._mode
-            reset = dict(ev.reset or {})
-            unknown = sorted(set(reset) - set(target.x))
-            if unknown:
-                raise ModelError(f"mode '{mode.name}', event '{ev.name}': reset names {unknown} are not states "
-                                 f"of target mode '{target.name}' ({list(target.x)})")
-            exprs = []
-            for name in target.x:
-                if name in reset:
-                    exprs.append(ca.SX(reset[name]))
-                elif name in mode.x:
-                    exprs.append(mode.x[name])
-                else:
-                    raise ModelError(f"mode '{mode.name}', event '{ev.name}': target mode '{target.name}' has "
-                                     f"state '{name}' that the source mode lacks; give it in reset=")
+            target = modes[ev.target]
+            exprs = reset_expressions(mode, ev, target)
             old = _column(list(mode.x.values()) + list(mode.z.values()))
             new = ca.vertcat(self.xs * ca.DM(mode.x_nominal), self.zs * ca.DM(mode.z_nominal)) \
                 if self.nz else self.xs * ca.DM(mode.x_nominal)
@@ -261,9 +264,76 @@ class CompiledMode:
         return dict(zip(self.z_names, zs * self.z_nominal))
 
 
+def reset_expressions(mode, ev, target):
+    """The target mode's states after event ``ev`` of ``mode`` (expressions in the source
+    variables): the reset's own, else the source state of the same name; ModelError if neither."""
+    reset = dict(ev.reset or {})
+    unknown = sorted(set(reset) - set(target.x))
+    if unknown:
+        raise ModelError(f"mode '{mode.name}', event '{ev.name}': reset names {unknown} are not states "
+                         f"of target mode '{target.name}' ({list(target.x)})")
+    exprs = []
+    for name in target.x:
+        if name in reset:
+            exprs.append(ca.SX(reset[name]))
+        elif name in mode.x:
+            exprs.append(mode.x[name])
+        else:
+            raise ModelError(f"mode '{mode.name}', event '{ev.name}': target mode '{target.name}' has "
+                             f"state '{name}' that the source mode lacks; give it in reset=")
+    return exprs
+
+
+def check_mode(mode, model):
+    """Raise ModelError if a mode uses symbols that are not its variables, the model's parameters,
+    inputs or time, or if a reset leaves a target state undefined (what compiling it would find,
+    without compiling it)."""
+    args = [_column(list(mode.x.values())), _column(list(mode.z.values())),
+            _column(list(model.p.values()) + list(model.u.values())), model.t]
+    groups = {"the ode": mode.ode, "the algebraic equations": mode.alg, "an output": list(mode.outputs.values()),
+              "an event function": [ev.function for ev in mode.events],
+              "an event guard": [ev.guard for ev in mode.events if ev.guard is not None]}
+    for ev in mode.events:
+        groups[f"the reset of event '{ev.name}'"] = reset_expressions(mode, ev, model.modes[ev.target])
+    for what, exprs in groups.items():
+        _function(f"{mode.name}_check", args, [_column([ca.SX(e) for e in exprs])], what, mode.name)
+
+
+class CompiledModes(Mapping):
+    """The compiled modes of a model by name, each compiled when a run first enters it.
+
+    A run visits few of the modes an engagement model declares (bao2020: 3 of 6), and compiling a
+    mode (common subexpressions, scaling, functions) costs as much as a warm run, so a sweep
+    whose every point is a new model pays only for the modes its runs enter. The compiled mode
+    is kept, so later runs of the same model reuse it (and its integrators).
+    """
+
+    def __init__(self, model):
+        self._model = model
+        self._done = {}
+
+    def __getitem__(self, name):
+        cm = self._done.get(name)
+        if cm is None:
+            mode = self._model.modes[name]            # KeyError for an unknown mode, as a dict
+            cm = CompiledMode(mode, self._model)
+            cm.build_resets(self._model.modes)
+            self._done[name] = cm
+        return cm
+
+    def __iter__(self):
+        return iter(self._model.modes)
+
+    def __len__(self):
+        return len(self._model.modes)
+
+    def __contains__(self, name):
+        return name in self._model.modes
+
+
 def compile_model(model):
-    """Compile every mode of a :class:`~clutchocp.simulation.model.HybridModel`."""
-    compiled = {name: CompiledMode(mode, model) for name, mode in model.modes.items()}
-    for cm in compiled.values():
-        cm.build_resets(compiled)
-    return compiled
+    """The modes of a :class:`~clutchocp.simulation.model.HybridModel`, checked now (:func:`check_mode`)
+    and compiled on first use (:class:`CompiledModes`)."""
+    for mode in model.modes.values():
+        check_mode(mode, model)
+    return CompiledModes(model)

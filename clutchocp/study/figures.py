@@ -1,0 +1,199 @@
+"""Figures of a study: lines (one swept field), heat maps (two), histograms and scatter (samples),
+and the family of optimal pressure curves (optimize)."""
+
+import math
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from ..output import save_figure
+from ..scene.schema import PARTS
+from .folder import CALIBRATION, _read_complete
+
+# The results drawn per task (at most four: a 2 x 2 panel figure).
+PLOTTED = {
+    "simulate": ("engagement_time_s", "lockup_torque_jump_Nm", "peak_torque_Nm", "dissipated_energy_J"),
+    "optimize": ("engagement_time_s", "jerk_integral", "peak_torque_Nm", "dissipated_energy_J"),
+}
+SUFFIX_UNITS = (("_rad_s3", "rad/s^3"), ("_Nm", "N m"), ("_J", "J"), ("_Pa", "Pa"), ("_s", "s"))
+
+
+NAMED_UNITS = {"jerk_integral": "rad^2/s^5", "objective": "-", "energy_balance_rel_error": "-"}
+
+
+def result_label(column):
+    """``"peak_torque_Nm"`` -> ``"peak torque [N m]"``."""
+    if column in NAMED_UNITS:
+        return f"{column.replace('_', ' ')} [{NAMED_UNITS[column]}]"
+    for suffix, unit in SUFFIX_UNITS:
+        if column.endswith(suffix):
+            return f"{column[: -len(suffix)].replace('_', ' ')} [{unit}]"
+    return column.replace("_", " ")
+
+
+def field_label(scene, name):
+    """``"load.torque"`` -> ``"load.torque [N m]"`` (the SI unit of the scene field)."""
+    part, _, key = name.partition(".")
+    spec = PARTS[part].allowed_fields(scene.variant(part)).get(key) if part in PARTS else None
+    unit = getattr(spec, "dim", "1") if spec is not None and getattr(spec, "kind", "") == "quantity" else "1"
+    return f"{name} [{unit}]" if unit != "1" else name
+
+
+def _figure(rows, cols, width=4.2, height=3.2):
+    fig = Figure(figsize=(width * cols, height * rows), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(rows, cols, squeeze=False)
+    return fig, axes.ravel()
+
+
+def _values(rows, column):
+    return np.array([r[column] if isinstance(r.get(column), float) and r["status"] == "ok" else np.nan
+                     for r in rows], float)
+
+
+def _title(scene, task, rows):
+    n_failed = sum(r["status"] != "ok" for r in rows)
+    failed = f", {n_failed} failed (not drawn)" if n_failed else ""
+    return f"{scene.name}: {task.kind} sweep, {len(rows)} points{failed}"
+
+
+def draw_study(out, scene, task, fields, rows, sampled):
+    """Draw the study's figures into ``out``; returns the paths written."""
+    plotted = [c for c in PLOTTED[task.kind] if np.isfinite(_values(rows, c)).any()]
+    files = []
+    if not rows or not plotted:
+        return files
+    numeric = [f for f in fields if all(isinstance(r[f], float) for r in rows)]
+    if sampled:
+        files.append(_histograms(out, scene, task, rows, plotted))
+        if numeric:
+            files.append(_scatter(out, scene, task, rows, plotted, numeric))
+    elif len(fields) == 1 and numeric:
+        files.append(_lines(out, scene, task, rows, plotted, fields[0]))
+    elif len(fields) == 2 and len(numeric) == 2:
+        files.append(_maps(out, scene, task, rows, plotted, fields))
+    if task.kind == "optimize":
+        path = _curves(out, scene, task, rows, fields)
+        if path is not None:
+            files.append(path)
+    return files
+
+
+def _lines(out, scene, task, rows, plotted, field):
+    x = np.array([r[field] for r in rows], float)
+    order = np.argsort(x)
+    n = len(plotted)
+    fig, axes = _figure(math.ceil(n / 2), min(n, 2))
+    for ax, column in zip(axes, plotted):
+        y = _values(rows, column)
+        ax.plot(x[order], y[order], "o-", color="C0")
+        ax.set_xlabel(field_label(scene, field))
+        ax.set_ylabel(result_label(column))
+        ax.grid(True, alpha=0.3)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    fig.suptitle(_title(scene, task, rows))
+    return save_figure(fig, out / "sweep_lines.png")
+
+
+def _maps(out, scene, task, rows, plotted, fields):
+    xs = np.unique([r[fields[1]] for r in rows])
+    ys = np.unique([r[fields[0]] for r in rows])
+    n = len(plotted)
+    fig, axes = _figure(math.ceil(n / 2), min(n, 2), width=4.8, height=3.6)
+    for ax, column in zip(axes, plotted):
+        grid = np.full((ys.size, xs.size), np.nan)
+        for r, v in zip(rows, _values(rows, column)):
+            grid[np.searchsorted(ys, r[fields[0]]), np.searchsorted(xs, r[fields[1]])] = v
+        mesh = ax.pcolormesh(_edges(xs), _edges(ys), np.ma.masked_invalid(grid), shading="flat", cmap="viridis")
+        fig.colorbar(mesh, ax=ax, label=result_label(column))
+        ax.set_xlabel(field_label(scene, fields[1]))
+        ax.set_ylabel(field_label(scene, fields[0]))
+        ax.set_title(result_label(column), fontsize=10)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    fig.suptitle(_title(scene, task, rows) + "\nblank cell: no value (a failed point, or no lock-up within t_end)",
+                 fontsize=11)
+    return save_figure(fig, out / "sweep_maps.png")
+
+
+def _edges(centres):
+    """Cell edges around sorted cell centres (half a step beyond the ends)."""
+    if centres.size == 1:
+        half = 0.05 * abs(centres[0]) or 0.5
+        return np.array([centres[0] - half, centres[0] + half])
+    mid = 0.5 * (centres[1:] + centres[:-1])
+    return np.concatenate([[2 * centres[0] - mid[0]], mid, [2 * centres[-1] - mid[-1]]])
+
+
+def _histograms(out, scene, task, rows, plotted):
+    n = len(plotted)
+    fig, axes = _figure(math.ceil(n / 2), min(n, 2))
+    for ax, column in zip(axes, plotted):
+        y = _values(rows, column)
+        y = y[np.isfinite(y)]
+        ax.hist(y, bins=max(5, min(30, int(np.sqrt(y.size)) + 1)), color="C0", alpha=0.8)
+        ax.axvline(np.mean(y), color="k", ls="--", lw=1, label=f"mean {np.mean(y):.4g}")
+        ax.set_xlabel(result_label(column))
+        ax.set_ylabel("points")
+        ax.legend(fontsize=8)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    fig.suptitle(_title(scene, task, rows).replace("sweep", "Monte Carlo"))
+    return save_figure(fig, out / "sample_histograms.png")
+
+
+def _scatter(out, scene, task, rows, plotted, fields):
+    fig, axes = _figure(len(plotted), len(fields), width=3.4, height=2.6)
+    axes = axes.reshape(len(plotted), len(fields))
+    for i, column in enumerate(plotted):
+        y = _values(rows, column)
+        for j, field in enumerate(fields):
+            ax = axes[i, j]
+            ax.plot([r[field] for r in rows], y, ".", color="C0", ms=4)
+            if i == len(plotted) - 1:
+                ax.set_xlabel(field_label(scene, field))
+            if j == 0:
+                ax.set_ylabel(result_label(column), fontsize=8)
+            ax.grid(True, alpha=0.3)
+    fig.suptitle(_title(scene, task, rows).replace("sweep", "Monte Carlo") + ": each result against each sampled field")
+    return save_figure(fig, out / "sample_scatter.png")
+
+
+def _curves(out, scene, task, rows, fields):
+    path = out / CALIBRATION
+    if not path.is_file():
+        return None
+    with path.open(encoding="utf-8") as fh:
+        header = fh.readline().strip().split(",")
+    table = _read_complete(path, header)
+    if not table:
+        return None
+    by_point = {}
+    for r in table:
+        by_point.setdefault(r["point_id"], []).append(r)
+    colour_field = fields[0] if fields and all(isinstance(r[fields[0]], float) for r in rows) else None
+    values = [r[colour_field] for r in rows] if colour_field else [0.0]
+    lo, hi = min(values), max(values)
+    fig, axes = _figure(1, 1, width=7.0, height=4.4)
+    ax = axes[0]
+    from matplotlib import cm, colors
+
+    norm = colors.Normalize(lo, hi if hi > lo else lo + 1)
+    for r in rows:
+        curve = by_point.get(r["point_id"])
+        if not curve:
+            continue
+        colour = cm.viridis(norm(r[colour_field])) if colour_field else "C0"
+        ax.plot([c["time_s"] for c in curve], [c["pressure_Pa"] / 1e6 for c in curve], color=colour, lw=1.2)
+    if colour_field:
+        fig.colorbar(cm.ScalarMappable(norm=norm, cmap="viridis"), ax=ax, label=field_label(scene, colour_field))
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("optimal pressure command [MPa]")
+    ax.grid(True, alpha=0.3)
+    t_max = task.options.get("t_max")
+    limit = f"t_max = {t_max:g} s" if t_max else "t_max = each point's own baseline lock-up time"
+    fig.suptitle(f"{scene.name}: optimal engagement pressure, {len(by_point)} operating points\n"
+                 f"each curve ends at its lock-up; {limit}", fontsize=10)
+    return save_figure(fig, out / "optimal_curves.png")

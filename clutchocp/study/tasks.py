@@ -1,0 +1,232 @@
+"""What a worker does with one unit of work: plain data in (scene, overrides, options), rows out.
+
+A unit is ``(task, points)``: ``task`` a :class:`Task` (scene name or path, ``"simulate"`` or
+``"optimize"``, options), ``points`` a list of override dictionaries. Nothing CasADi crosses a
+process boundary; each worker loads the scene once and builds the models of its points itself.
+An optimize unit is a chain of neighbouring grid points solved in order, each starting from the
+optimum of the previous one (``EngagementOCP.solve(guess=...)``).
+
+Every point gives a row ``{field: value, ..., "point_id", "status", "reason", <numbers>}``; a point
+that fails gives ``status = "failed"`` and the one-line reason, and the unit goes on.
+"""
+
+import functools
+import time
+from dataclasses import asdict, dataclass, field
+
+from ..errors import ClutchocpError, ModelError, SolverError
+from .points import point_id
+
+TASKS = ("simulate", "optimize")
+
+# Result columns per task, with units in the names (the CSV header and summary.json use them).
+SIMULATE_RESULTS = ("engagement_time_s", "lockup_torque_jump_Nm", "peak_torque_Nm", "peak_jerk_rad_s3",
+                    "dissipated_energy_J", "energy_balance_rel_error", "torque_response_time_s",
+                    "pressure_response_time_s", "final_mode")
+SIMULATE_COLUMNS = SIMULATE_RESULTS + ("n_steps", "model_reused", "native_code", "build_time_s", "integration_time_s",
+                                       "run_time_s")
+OPTIMIZE_COLUMNS = ("engagement_time_s", "t_max_s", "jerk_integral", "dissipated_energy_J", "lockup_torque_jump_Nm",
+                    "peak_jerk_rad_s3", "peak_torque_Nm", "objective", "ipopt_iterations", "solve_time_s",
+                    "build_time_s", "warm_start", "idas_lock_time_rel_diff", "run_time_s")
+STATUS_COLUMNS = ("point_id", "status", "reason")
+# Options of each task with their defaults (see Task).
+DEFAULT_OPTIONS = {
+    "simulate": {"output_points": None, "rtol": None, "atol": None, "native": "auto", "reuse_model": True},
+    "optimize": {"intervals": 40, "degree": 3, "t_max": None, "weights": None, "warm_start": True, "verify": True},
+}
+
+
+def task_options(kind, options):
+    """``options`` completed with the defaults of task ``kind`` (ModelError for an unknown option)."""
+    defaults = DEFAULT_OPTIONS[kind]
+    unknown = sorted(set(options or {}) - set(defaults))
+    if unknown:
+        raise ModelError(f"{kind} sweep: unknown option(s) {', '.join(unknown)} (allowed: {', '.join(defaults)})")
+    return {**defaults, **(options or {})}
+
+
+@dataclass(frozen=True)
+class Task:
+    """What to do at every point of a study (plain data: picklable, cheap to send).
+
+    Parameters
+    ----------
+    scene : str
+        Built-in scene name or path of a scene file.
+    kind : {"simulate", "optimize"}
+    base_overrides : dict
+        ``{"part.key": value}`` applied to the scene before each point's own overrides (``--set``).
+    options : dict
+        simulate: ``output_points`` (int, output grid of a run; None: the scene's), ``rtol``,
+        ``atol``, ``reuse_model`` (bool, default True: one model per worker with the swept fields
+        as parameters, :mod:`clutchocp.study.parametric`, where the model allows it; False: a new
+        model per point, bit for bit the single-run results), ``native`` (``"auto"``, default:
+        compiled C for a reused model where a C compiler exists; True: for every model; False: never). optimize: ``intervals``, ``degree``, ``t_max`` [s] (None: each
+        point's own baseline lock time), ``weights``, ``warm_start`` (bool, default True),
+        ``verify`` (bool, default True: replay each optimum with IDAS). Missing options take the
+        defaults of :data:`DEFAULT_OPTIONS`.
+    """
+
+    scene: str
+    kind: str = "simulate"
+    base_overrides: dict = field(default_factory=dict)
+    options: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.kind not in TASKS:
+            raise ModelError(f"--task {self.kind!r}: allowed values are {', '.join(TASKS)}")
+        object.__setattr__(self, "options", task_options(self.kind, self.options))
+
+    def columns(self):
+        """Result columns of this task (without the parameter and status columns)."""
+        return SIMULATE_COLUMNS if self.kind == "simulate" else OPTIMIZE_COLUMNS
+
+    def as_dict(self):
+        return asdict(self)
+
+
+@functools.lru_cache(maxsize=8)
+def _base_scene(scene, overrides_items):
+    from ..scene import load_scene
+    return load_scene(scene, overrides=dict(overrides_items) or None)
+
+
+def point_scene(task, point):
+    """The scene of one point: the task's scene with its base overrides, then the point's."""
+    base = _base_scene(task.scene, tuple(sorted(task.base_overrides.items(), key=lambda kv: kv[0])))
+    return base.with_overrides(point) if point else base
+
+
+def reason_of(exc):
+    """One line saying why a point failed (the message of a clutchocp error; else the type too)."""
+    text = str(exc).replace("\n", " ").strip()
+    return text if isinstance(exc, ClutchocpError) else f"{type(exc).__name__}: {text}"
+
+
+def _row(point, status, reason, numbers):
+    return {**point, "point_id": point_id(point), "status": status, "reason": reason, **numbers}
+
+
+def run_unit(task, points):
+    """Run one unit of work in this process.
+
+    Returns
+    -------
+    list of (dict, dict or None)
+        Per point its row and, for a solved optimize point, its command curve
+        ``{"time_s": [...], "pressure_Pa": [...]}`` (else None).
+    """
+    if task.kind == "simulate":
+        return [simulate_point(task, point) for point in points]
+    return optimize_chain(task, points)
+
+
+def simulate_point(task, point):
+    """Simulate one point; returns ``(row, None)``."""
+    from ..engagement.model import EngagementModel
+    from ..engagement.run import simulate_engagement
+    from ..simulation.native import compiler
+
+    opts = task.options
+    has_compiler = compiler() is not None                       # no compiler: the VM, silently
+    settings = {"rtol": opts["rtol"], "atol": opts["atol"], "output_points": opts["output_points"]}
+    start = time.perf_counter()
+    try:
+        scene = point_scene(task, point)
+        native = has_compiler and opts["native"] in (True, "auto")
+        run = _simulate_reusing(task, point, scene, dict(settings, native=native)) if opts["reuse_model"] else None
+        reused = run is not None
+        built = start
+        if run is None:
+            native = has_compiler and opts["native"] is True
+            model = EngagementModel(scene)
+            built = time.perf_counter()
+            run = simulate_engagement(scene, model=model, native=native, **settings)
+    except Exception as exc:                  # a failed point is recorded, never stops the sweep
+        return _row(point, "failed", reason_of(exc), {"run_time_s": time.perf_counter() - start}), None
+    s = run.summary
+    numbers = {key: s[key] for key in SIMULATE_RESULTS}
+    numbers.update(n_steps=int(s["solver"]["statistics"]["n_steps"]), model_reused=reused, native_code=native,
+                   build_time_s=built - start,
+                   integration_time_s=float(s["solver"]["statistics"]["integration_time_s"]),
+                   run_time_s=time.perf_counter() - start)
+    return _row(point, "ok", "", numbers), None
+
+
+_PARAMETRIC = {}        # this worker's parametric models: key -> [ParametricModel or None, checked]
+
+
+def _simulate_reusing(task, point, scene, settings):
+    """The run of ``point`` on this worker's parametric model, or None where it cannot be used
+    (a choice field, a field the model cannot take as a symbol, a run that fails: the usual run
+    then gives the result or the failure and its reason)."""
+    from ..engagement.run import simulate_engagement
+    from . import parametric
+
+    names = tuple(sorted(point))
+    if not all(isinstance(point[n], float) for n in names):
+        return None
+    key = (task.scene, tuple(sorted(task.base_overrides.items(), key=lambda kv: kv[0])), names)
+    entry = _PARAMETRIC.get(key)
+    if entry is None:
+        entry = _PARAMETRIC[key] = [parametric.build(point_scene(task, {}), names), False]
+    if entry[0] is None:
+        return None
+    view, values = entry[0].for_point(scene)
+    try:
+        run = simulate_engagement(scene, model=view, parameters=values, **settings)
+    except Exception:
+        return None
+    if not entry[1]:                          # the first point: check against the usual run once
+        reference = simulate_engagement(scene, **dict(settings, native=False))
+        if not parametric.agrees(run.summary, reference.summary):
+            entry[0] = None
+            return None
+        entry[1] = True
+    return run
+
+
+def optimize_chain(task, points):
+    """Solve the optimal engagement at consecutive points, each warm-started from the previous optimum."""
+    previous = None
+    out = []
+    for point in points:
+        row, curve, optimum = optimize_point(task, point, guess=previous)
+        out.append((row, curve))
+        if task.options["warm_start"]:
+            previous = optimum if optimum is not None else previous
+    return out
+
+
+def optimize_point(task, point, guess=None):
+    """Solve one point; returns ``(row, curve, optimum)`` (``curve`` and ``optimum`` None on failure)."""
+    from ..optimal.problem import EngagementOCP
+    from ..optimal.verify import verify
+
+    opts = task.options
+    start = time.perf_counter()
+    try:
+        scene = point_scene(task, point)
+        ocp = EngagementOCP(scene, intervals=opts["intervals"], degree=opts["degree"])
+        built = time.perf_counter()
+        try:
+            optimum = ocp.solve(t_max=opts["t_max"], weights=opts["weights"], guess=guess)
+        except SolverError:
+            if guess is None:
+                raise
+            # a neighbour's optimum too far off to start from: solve this point cold
+            optimum = ocp.solve(t_max=opts["t_max"], weights=opts["weights"])
+        numbers = {key: optimum.terms[key] for key in ("engagement_time_s", "jerk_integral", "dissipated_energy_J",
+                                                       "lockup_torque_jump_Nm", "peak_jerk_rad_s3", "peak_torque_Nm",
+                                                       "objective")}
+        numbers.update(t_max_s=float(optimum.t_max), ipopt_iterations=int(optimum.stats["iterations"]),
+                       solve_time_s=float(optimum.stats["wall_time_s"]), build_time_s=built - start,
+                       warm_start=bool(optimum.stats["warm_start"]))
+        if opts["verify"]:
+            check, _ = verify(ocp.exact if ocp.polish else ocp, optimum)
+            numbers["idas_lock_time_rel_diff"] = check["lock_time_rel_diff"]
+    except Exception as exc:                  # a failed point is recorded, never stops the sweep
+        return _row(point, "failed", reason_of(exc), {"run_time_s": time.perf_counter() - start}), None, None
+    numbers["run_time_s"] = time.perf_counter() - start
+    curve = {"time_s": [float(t) for t in optimum.command_times], "pressure_Pa": [float(p) for p in optimum.command]}
+    return _row(point, "ok", "", numbers), curve, optimum

@@ -186,6 +186,25 @@ FLAG_CASES = [
     (OPT + ["--sweep-t-max", "0.2:0.3:1"], ["--sweep-t-max", "count"]),
     (OPT + ["--sweep-t-max", "0.2:0.3:1000"], ["--sweep-t-max", "count"]),
     (OPT + ["--sweep-t-max", "0.2:0.3:2.5"], ["--sweep-t-max"]),
+    (OPT + ["--max-temperature", "nan"], ["--max-temperature", "degC"]),
+    (OPT + ["--max-temperature", "-300"], ["--max-temperature", "-273.15"]),
+    (OPT + ["--max-specific-power", "0"], ["--max-specific-power"]),
+    (OPT + ["--max-specific-power", "inf"], ["--max-specific-power"]),
+    (["sweep", "zhang2021", "--samples", "0"], ["--samples", "from 1"]),
+    (["sweep", "zhang2021", "--seed", "-1"], ["--seed", "from 0"]),
+    (["sweep", "zhang2021", "--workers", "0"], ["--workers", "from 1"]),
+    (["sweep", "zhang2021", "--output-points", "1"], ["--output-points", "from 2"]),
+    (["sweep", "zhang2021", "--task", "optimize", "--t-max", "nan"], ["--t-max", "positive"]),
+    (["sweep", "zhang2021", "--task", "optimize", "--intervals", "1"], ["--intervals", "from 2"]),
+    (["sweep", "zhang2021", "--task", "optimize", "--degree", "10"], ["--degree", "from 1 to 9"]),
+    (["robust", "--samples", "-5"], ["--samples", "from 1"]),
+    (["robust", "--seed", "x"], ["--seed", "integer"]),
+    (["robust", "--t-max", "0"], ["--t-max", "positive"]),
+    (["robust", "--workers", "0"], ["--workers", "from 1"]),
+    (["robust", "--intervals", "100000"], ["--intervals", "from 2 to 2000"]),
+    (["cycles", "default_driveline_thermal", "--cycles", "0"], ["--cycles", "from 1"]),
+    (["cycles", "default_driveline_thermal", "--cooling-time", "-1"], ["--cooling-time", ">= 0"]),
+    (["cycles", "default_driveline_thermal", "--max-temperature", "inf"], ["--max-temperature"]),
     (["optimize", "bao2020"], ["actuation.max_pressure"]),
     (["control", "zhang2021"], ["hvd"]),
     (["control", "liao2021_hvd", "--controller", "no_such_controller"], ["no_such_controller", "lqi, pi"]),
@@ -198,7 +217,7 @@ FLAG_CASES = [
 @pytest.mark.parametrize("argv, words", FLAG_CASES, ids=[" ".join(a[:1] + a[2:])[:60] or "no-args"
                                                           for a, _ in FLAG_CASES])
 def test_command_line_mistakes(argv, words, tmp_path, capsys):
-    needs_out = argv and argv[0] in ("simulate", "optimize", "control")
+    needs_out = argv and argv[0] in ("simulate", "optimize", "control", "sweep", "robust", "cycles")
     code = main(argv + (["--out", str(tmp_path / "out")] if needs_out else []))
     assert code == 2
     assert_one_line(capsys, words)

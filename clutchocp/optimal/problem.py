@@ -152,6 +152,11 @@ class EngagementOCP:
         IDAS run of the scene's own profile (initial guess and scales; simulated if not given).
     """
 
+    # Scene values that are a parameter vector of the NLP functions (appended to the weights; the
+    # outputs and jump functions take it as a third input); empty here, set by
+    # clutchocp.optimal.robust.ParametricOCP for the scenarios of a robust problem.
+    theta = ca.SX(0, 1)
+
     def __init__(self, scene, *, intervals=100, degree=3, scheme="radau", control="linear", rate_limit=None,
                  h_min=None, jump="constraint", lock_margin=0.005, smooth=True, polish=True,
                  transcription=None, baseline=None):
@@ -293,7 +298,8 @@ class EngagementOCP:
             return ca.cse(ca.substitute(expr, ca.vertcat(model.x, self.u), ca.vertcat(x_full, u)))
 
         self.output_names = list(physical)
-        self.outputs_fn = ca.Function("outputs", [xs, us], [subs(ca.vertcat(*physical.values()))])
+        theta = [self.theta] if self.theta.numel() else []
+        self.outputs_fn = ca.Function("outputs", [xs, us, *theta], [subs(ca.vertcat(*physical.values()))])
         t_ref = sc.time_s
         xdot = ca.vertcat(subs(ode[self._phys]) / self.nominal,
                           subs(physical["dissipated_power_W"]) / sc.energy_J) * t_ref
@@ -302,7 +308,8 @@ class EngagementOCP:
         w_scale = max(self.scene.value("driveline.input_speed"), self.scene.get("driveline.output_speed", 0.0), 1.0)
         slip = subs(w_rel) / w_scale
         weights = ca.SX.sym("weights", len(OBJECTIVE_TERMS))
-        self.dynamics_fn = ca.Function("dynamics", [xs, us, weights], [xdot, q, slip])
+        params = ca.vertcat(weights, self.theta)
+        self.dynamics_fn = ca.Function("dynamics", [xs, us, params], [xdot, q, slip])
         # Objective and end conditions (w_rel = 0, jump = 0 unless penalised, energy <= E_max).
         Q = ca.SX.sym("Q", 2)
         T = ca.SX.sym("T")
@@ -311,13 +318,13 @@ class EngagementOCP:
         jump_condition = (locked * (1 + self.lock_margin) - slipping) / sc.torque_Nm
         w = dict(zip(OBJECTIVE_TERMS, ca.vertsplit(weights)))
         J = w["jerk"] * Q[0] + w["energy"] * xs[n] + w["time"] * T + w["jump"] * jump**2 + w["smooth"] * Q[1]
-        self.objective_fn = ca.Function("objective", [xs, us, Q, T, weights], [J])
+        self.objective_fn = ca.Function("objective", [xs, us, Q, T, params], [J])
         # The lock must hold: the static capacity (about the slipping torque at lock-up) may not be
         # falling at t_f. Without this row the optimum lets the pressure fall through lock-up.
         capacity_rate = subs(physical["capacity_rate_Nm_s"]) * t_ref / sc.torque_Nm
         g_end = [slip] + ([jump_condition] if self.jump_mode == "constraint" else []) + [capacity_rate, xs[n]]
-        self.end_fn = ca.Function("end", [xs, us, T, weights], [ca.vertcat(*g_end)])
-        self.jump_fn = ca.Function("jump", [xs, us], [jump * sc.torque_Nm])
+        self.end_fn = ca.Function("end", [xs, us, T, params], [ca.vertcat(*g_end)])
+        self.jump_fn = ca.Function("jump", [xs, us, *theta], [jump * sc.torque_Nm])
 
     def _staged_problem(self):
         n = len(self._phys)

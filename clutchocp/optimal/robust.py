@@ -208,7 +208,8 @@ class RobustOCP:
     scenarios : list of dict
         Override dicts, one per scenario (SI floats for numeric fields).
     intervals, degree : int
-        Collocation intervals per scenario (also the steps of the command grid) and points per interval.
+        Steps of the command grid over [0, t_max] (a scenario that locks at t_max has as many
+        collocation intervals) and collocation points per interval.
     **ocp_options
         Options of :class:`~clutchocp.optimal.problem.EngagementOCP` (rate_limit, h_min, jump,
         lock_margin, smooth, polish, scheme); the command is piecewise linear.
@@ -223,10 +224,11 @@ class RobustOCP:
         self.overrides = [dict(d) for d in scenarios]
         self.ocp = ParametricOCP(scene, self.names, intervals=intervals, degree=degree, **ocp_options)
         self.thetas = np.array([self.ocp.nominal_theta(s) for s in self.scenes]).reshape(len(self.scenes), -1)
-        self.transcription = self.ocp.transcription
+        self.intervals = int(intervals)
         self._nlps = {}
         self._solvers = {}
         self._fastest = None
+        self._runs = None
 
     @property
     def n_scenarios(self):
@@ -249,24 +251,25 @@ class RobustOCP:
         return self._fastest
 
     # -- transcription ------------------------------------------------------------------------
-    def nlp(self, ocp, aggregate, t_max):
-        """The robust NLP on ``ocp``'s functions (smooth or exact) for a command grid over [0, t_max]."""
-        key = (id(ocp), aggregate, float(t_max))
+    def nlp(self, ocp, aggregate, t_max, lock_intervals):
+        """The robust NLP on ``ocp``'s functions for a command grid over [0, t_max] and the
+        command interval each scenario locks in."""
+        key = (id(ocp), aggregate, float(t_max), tuple(lock_intervals))
         if key not in self._nlps:
-            self._nlps[key] = _transcribe(ocp, self.n_scenarios, aggregate, t_max / ocp.scales.time_s)
+            self._nlps[key] = _transcribe(ocp, aggregate, t_max / ocp.scales.time_s, self.intervals,
+                                          tuple(int(k) for k in lock_intervals))
         return self._nlps[key]
 
-    def solver(self, ocp, aggregate, t_max, warm):
-        key = (id(ocp), aggregate, float(t_max), warm)
+    def solver(self, nlp, warm):
+        key = (id(nlp), warm)
         if key not in self._solvers:
-            nlp = self.nlp(ocp, aggregate, t_max)
             options = dict(IPOPT_OPTIONS, **(WARM_OPTIONS if warm else {}))
             self._solvers[key] = ca.nlpsol(f"robust_{'warm' if warm else 'cold'}", "ipopt", nlp.nlp,
                                            {"print_time": False, "ipopt": options, "error_on_fail": False})
         return self._solvers[key]
 
     # -- solving ------------------------------------------------------------------------------
-    def solve(self, *, t_max=None, weights=None, aggregate="mean", scenario_weights=None, guess=None):
+    def solve(self, *, t_max=None, weights=None, aggregate="mean", scenario_weights=None, max_shifts=12):
         """Solve for the robust command (smooth stage, then the polish on the exact forms).
 
         Parameters
@@ -280,8 +283,8 @@ class RobustOCP:
             Weighted mean of the scenario objectives, or the worst (epigraph).
         scenario_weights : sequence of float, optional
             Weights of the scenarios in the mean (normalised; default equal).
-        guess : RobustEngagement, optional
-            A previous robust optimum of this problem (warm start).
+        max_shifts : int
+            Largest number of re-solves that move a scenario's lock-up into the next command interval.
 
         Returns
         -------
@@ -314,11 +317,10 @@ class RobustOCP:
                              f"{self.overrides[k]} ({fastest[k]:.4g} s with a step to actuation.max_pressure); "
                              "raise t_max or the pressure limit")
         stages = []
-        result = self._solve_stage(ocp, t_max, weights, aggregate, omega, guess)
-        stages.append(dict(result.stats, model="smooth" if ocp.smooth else "exact"))
+        result = self._solve_model(ocp, t_max, weights, aggregate, omega, None, max_shifts, stages, "smooth")
         if ocp.polish and result.success:
-            polished = self._solve_stage(ocp.exact, t_max, weights, aggregate, omega, result)
-            stages.append(dict(polished.stats, model="exact"))
+            polished = self._solve_model(ocp.exact, t_max, weights, aggregate, omega, result, max_shifts, stages,
+                                         "exact")
             if polished.success:
                 result = polished
         result.stats = dict(stages[-1], iterations=sum(s["iterations"] for s in stages),
@@ -331,163 +333,313 @@ class RobustOCP:
                               "scenarios, or other weights")
         return result
 
-    def _solve_stage(self, ocp, t_max, weights, aggregate, omega, guess):
-        nlp = self.nlp(ocp, aggregate, t_max)
-        sc = ocp.scales
-        warm = isinstance(guess, RobustEngagement) and guess.w.size == nlp.lbx.size
-        if warm:
-            w0, lam_x0, lam_g0 = guess.w.copy(), guess.lam_x, guess.lam_g
+    def _solve_model(self, ocp, t_max, weights, aggregate, omega, guess, max_shifts, stages, label):
+        """Solve on one model (smooth or exact), moving lock-ups between command intervals until
+        no scenario's lock-up sits on the end of its interval with a multiplier pushing it out."""
+        h_c = t_max / self.intervals
+        if guess is None:
+            t_guess = self._lock_guess(t_max)
         else:
-            w0 = self._guess(ocp, nlp, t_max)
+            t_guess = guess.lock_times
+        lock_intervals = np.clip(np.ceil(t_guess / h_c - 1e-9).astype(int) - 1, 0, self.intervals - 1)
+        result = None
+        for _ in range(max_shifts + 1):
+            nlp = self.nlp(ocp, aggregate, t_max, lock_intervals)
+            warm = result is None and guess is not None and guess.w.size == nlp.lbx.size \
+                and tuple(guess.stats.get("lock_intervals", ())) == tuple(lock_intervals)
+            result = self._solve_stage(ocp, nlp, t_max, weights, aggregate, omega, guess if warm else None,
+                                       result or guess, warm)
+            stages.append(dict(result.stats, model=label))
+            if not result.success:
+                return result
+            moves = nlp.interval_moves(result.w, result.lam_x)
+            if not np.any(moves):
+                break
+            lock_intervals = lock_intervals + moves
+        return result
+
+    def _lock_guess(self, t_max):
+        """First guess of each scenario's lock-up [s]: its baseline run's, no later than t_max."""
+        runs = self._baseline_runs()
+        return np.array([min(r.summary["engagement_time_s"] or t_max, t_max) for r in runs])
+
+    def _baseline_runs(self):
+        if self._runs is None:
+            self._runs = [simulate_engagement(s) for s in self.scenes]
+        return self._runs
+
+    def _solve_stage(self, ocp, nlp, t_max, weights, aggregate, omega, warm_from, start_from, warm):
+        sc = ocp.scales
+        if warm:
+            w0, lam_x0, lam_g0 = warm_from.w.copy(), warm_from.lam_x, warm_from.lam_g
+        else:
+            w0 = self._guess(ocp, nlp, t_max, start_from)
             lam_x0, lam_g0 = np.zeros_like(w0), np.zeros(nlp.lbg.size)
-        lbx, ubx = nlp.lbx.copy(), nlp.ubx.copy()
-        lbx[nlp.T] = 1e-3 * t_max / sc.time_s
-        ubx[nlp.T] = t_max / sc.time_s
-        w0 = np.clip(w0, lbx, ubx)
+        w0 = np.clip(w0, nlp.lbx, nlp.ubx)
         p = np.concatenate([[weights[k] for k in OBJECTIVE_TERMS], self.thetas.ravel(), omega])
-        solver = self.solver(ocp, aggregate, t_max, warm)
+        solver = self.solver(nlp, warm)
         start = time.perf_counter()
-        sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg, p=p)
+        sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg, p=p)
         wall = time.perf_counter() - start
         st = solver.stats()
         stats = {"status": st["return_status"], "success": bool(st["success"]), "iterations": int(st["iter_count"]),
                  "wall_time_s": wall, "warm_start": bool(warm), "n_variables": int(w0.size),
-                 "n_constraints": int(nlp.lbg.size), "n_scenarios": self.n_scenarios}
-        w = np.array(sol["x"]).ravel()
-        return self._result(ocp, nlp, w, np.array(sol["lam_x"]).ravel(), np.array(sol["lam_g"]).ravel(),
-                            float(sol["f"]), p, weights, aggregate, omega, t_max, stats)
+                 "n_constraints": int(nlp.lbg.size), "n_scenarios": self.n_scenarios,
+                 "lock_intervals": [int(k) for k in nlp.lock_intervals]}
+        return self._result(ocp, nlp, np.array(sol["x"]).ravel(), np.array(sol["lam_x"]).ravel(),
+                            np.array(sol["lam_g"]).ravel(), float(sol["f"]), p, weights, aggregate, omega, t_max,
+                            stats, sc)
 
-    def _guess(self, ocp, nlp, t_max):
-        """Start point: each scenario's states from its own baseline run (compressed to t_max if
-        slower), the command from the nominal scene's baseline run."""
+    def _guess(self, ocp, nlp, t_max, previous):
+        """Start point: a previous robust solution interpolated onto this mesh, or each scenario's
+        own baseline run (compressed to t_max if slower) with the nominal baseline's command."""
+        sc = ocp.scales
+        if previous is not None:
+            t_lock = previous.lock_times
+        else:
+            t_lock = np.array([min(r.summary["engagement_time_s"] or t_max, t_max) for r in self._baseline_runs()])
+        T = nlp.clip_lock_times(t_lock / sc.time_s)
+        times = nlp.scenario_times(T)                           # scaled node / point times per scenario
+        xs, xcs = [], []
+        if previous is not None:
+            for k, opt in enumerate(previous.scenarios):
+                t_old = opt.t / sc.time_s
+
+                def at(t, opt=opt, t_old=t_old):
+                    cols = [np.interp(t, t_old, opt.states[name]) / nom for name, nom in zip(ocp.state_names,
+                                                                                          ocp.nominal)]
+                    cols.append(np.interp(t, t_old, opt.outputs["dissipated_energy_J"]) / sc.energy_J)
+                    return np.stack(cols, axis=-1)
+                xs.append(at(times[k][0]))
+                xcs.append(at(times[k][1]))
+            v = np.interp(nlp.command_grid, previous.command_times / sc.time_s, previous.command / sc.pressure_Pa)
+            return nlp.pack(xs, xcs, v, T)
         tr = ocp.transcription
-        xs, xcs, Ts = [], [], []
-        for s in self.scenes:
-            run = simulate_engagement(s)
-            parts = ocp.nlp.unpack(guess_from_run(ocp, run, t_max=0.95 * t_max))
-            xs.append(parts["x"])
-            xcs.append(parts["xc"])
-            Ts.append(parts["T"])
-        base = ocp.nlp.unpack(guess_from_run(ocp, ocp.reference_run, t_max=0.95 * t_max))
-        t_base = tr.node_times(base["T"])[0]
-        v = np.interp(nlp.command_grid, t_base, base["u"][:, 0])
-        return nlp.pack(xs, xcs, v, np.array(Ts))
+        for k, run in enumerate(self._baseline_runs()):
+            parts = ocp.nlp.unpack(guess_from_run(ocp, run, t_max=t_max))
+            t_run = tr.node_times(parts["T"])[0]
+            xcol = [np.stack([np.interp(t, t_run, parts["x"][:, i]) for i in range(parts["x"].shape[1])], axis=-1)
+                    for t in times[k]]
+            xs.append(xcol[0])
+            xcs.append(xcol[1])
+        base = ocp.nlp.unpack(guess_from_run(ocp, ocp.reference_run, t_max=t_max))
+        v = np.interp(nlp.command_grid, tr.node_times(base["T"])[0], base["u"][:, 0])
+        return nlp.pack(xs, xcs, v, T)
 
-    def _result(self, ocp, nlp, w, lam_x, lam_g, objective, p, weights, aggregate, omega, t_max, stats):
+    def _result(self, ocp, nlp, w, lam_x, lam_g, objective, p, weights, aggregate, omega, t_max, stats, sc):
         parts = nlp.unpack(w)
-        sc, tr = ocp.scales, ocp.transcription
         command = np.clip(parts["v"], 0.0, 1.0) * sc.pressure_Pa
-        times = nlp.command_grid * sc.time_s
         J = np.array(nlp.objectives_fn(w, p)).ravel()
+        times = nlp.scenario_times(parts["T"])
         scenarios = []
         for k in range(self.n_scenarios):
-            T = parts["T"][k]
-            starts, _ = tr.node_times(T)
-            u_nodes = np.interp(starts, nlp.command_grid, parts["v"])
-            w_k = ocp.nlp.pack(parts["x"][k], parts["xc"][k], u_nodes[:, None], T)
             ocp.theta_value = self.thetas[k]
-            scenarios.append(ocp._result(w_k, np.zeros_like(w_k), np.zeros(ocp.nlp.lbg.size), float(J[k]),
-                                         weights, dict(stats)))
-            scenarios[-1].t_max = t_max
+            scenarios.append(_scenario_result(ocp, nlp, parts, k, times[k], float(J[k]), weights, stats, t_max))
         ocp.theta_value = ocp.nominal_theta(self.scene)
-        return RobustEngagement(times, command, scenarios, self.overrides, J, objective, aggregate, weights, omega,
-                                t_max, stats, w, lam_x, lam_g)
+        return RobustEngagement(nlp.command_grid * sc.time_s, command, scenarios, self.overrides, J, objective,
+                                aggregate, weights, omega, t_max, stats, w, lam_x, lam_g)
+
+
+def _scenario_result(ocp, nlp, parts, k, times, objective, weights, stats, t_max):
+    """One scenario of a robust solution as an OptimalEngagement (its own mesh, the shared command)."""
+    sc, d = ocp.scales, ocp.transcription.degree
+    starts, points = times
+    T = parts["T"][k]
+    x, xc = parts["x"][k], parts["xc"][k]
+    v = np.clip(parts["v"], 0.0, 1.0)
+    u_nodes = np.interp(starts, nlp.command_grid, v)
+    u_points = np.interp(points, nlp.command_grid, v)
+    outputs = ocp._evaluate(x, u_nodes)
+    outputs["dissipated_energy_J"] = x[:, -1] * sc.energy_J
+    flat = ocp._evaluate(xc.reshape(-1, xc.shape[-1]), u_points.ravel())
+    outputs_points = {name: value.reshape(points.shape) for name, value in flat.items()}
+    steps = np.diff(starts)[:, None]                             # scaled interval lengths
+    quad = ocp.transcription.B[None, :] * steps * sc.time_s
+    terms = {
+        "jerk_integral": float(np.sum(quad * outputs_points["output_jerk_rad_s3"] ** 2)),
+        "slip_jerk_integral": float(np.sum(quad * outputs_points["slip_jerk_rad_s3"] ** 2)),
+        "dissipated_energy_J": float(x[-1, -1] * sc.energy_J),
+        "engagement_time_s": T * sc.time_s,
+        "lockup_torque_jump_Nm": float(ocp.jump_fn(x[-1], u_nodes[-1])),
+        "final_slip_rad_s": float(outputs["w_rel_rad_s"][-1]),
+        "locked_torque_Nm": float(outputs["locked_torque_Nm"][-1]),
+        "peak_jerk_rad_s3": float(np.max(np.abs(outputs_points["output_jerk_rad_s3"]))),
+        "peak_torque_Nm": float(np.max(np.abs(outputs_points["total_torque_Nm"]))),
+        "objective": objective,
+    }
+    nominal = ocp.nominal
+    states = {member: x[:, i] * nominal[i] for i, name in enumerate(ocp.state_names)
+              for member in ocp.state_groups[name]}
+    empty = np.zeros(0)
+    result = OptimalEngagement(T * sc.time_s, starts * sc.time_s, points * sc.time_s, starts * sc.time_s,
+                               u_nodes * sc.pressure_Pa, "linear", states, outputs, outputs_points, terms, objective,
+                               dict(stats), empty, empty, empty, weights)
+    result.t_max = t_max
+    return result
 
 
 @dataclass
 class _RobustNLP:
-    """The robust NLP and how to read its variables (scaled units)."""
+    """The robust NLP and how to read its variables (scaled units).
+
+    Scenario s has ``lock_intervals[s]`` = K_s full command intervals, then a last interval of free
+    length tau_s in (0, h_c] (its lock-up at T_s = K_s h_c + tau_s).
+    """
 
     nlp: dict
     lbx: np.ndarray
     ubx: np.ndarray
     lbg: np.ndarray
     ubg: np.ndarray
-    layout: dict
-    T: slice
-    command_grid: np.ndarray            # scaled times of the command nodes
-    objectives_fn: ca.Function          # (w, p) -> J_s of each scenario
+    x_offsets: list                    # (start, n_nodes) of each scenario's node states in w
+    xc_offsets: list                   # (start, n_points) of each scenario's point states in w
+    v_slice: slice
+    tau_slice: slice
+    n_x: int
+    degree: int
+    tau: np.ndarray                    # collocation points in (0, 1]
+    h_c: float
+    lock_intervals: tuple
+    command_grid: np.ndarray           # scaled times of the command nodes
+    objectives_fn: ca.Function         # (w, p) -> J_s of each scenario
+    tau_min: float
+
+    @property
+    def t_upper(self):
+        return self.command_grid[-1]
 
     def unpack(self, w):
         w = np.asarray(w, float).ravel()
-        out = {name: w[start:start + int(np.prod(shape))].reshape(shape) for name, (start, shape) in self.layout.items()}
-        out["T"] = w[self.T]
-        return out
+        d, n_x = self.degree, self.n_x
+        x = [w[a:a + n * n_x].reshape(n, n_x) for a, n in self.x_offsets]
+        xc = [w[a:a + n * n_x].reshape(n // d, d, n_x) for a, n in self.xc_offsets]
+        tau = w[self.tau_slice]
+        T = np.array(self.lock_intervals) * self.h_c + tau
+        return {"x": x, "xc": xc, "v": w[self.v_slice], "tau": tau, "T": T}
 
     def pack(self, x, xc, v, T):
         w = np.zeros(self.lbx.size)
-        for name, value in (("x", x), ("xc", xc), ("v", v)):
-            start, shape = self.layout[name]
-            value = np.asarray(value, float)
-            if value.shape != shape:
-                raise ModelError(f"robust guess '{name}': expected shape {shape}, got {value.shape}")
-            w[start:start + value.size] = value.ravel()
-        w[self.T] = T
+        for (a, n), xs in zip(self.x_offsets, x):
+            w[a:a + n * self.n_x] = np.asarray(xs, float).ravel()
+        for (a, n), xcs in zip(self.xc_offsets, xc):
+            w[a:a + n * self.n_x] = np.asarray(xcs, float).ravel()
+        w[self.v_slice] = v
+        w[self.tau_slice] = np.asarray(T, float) - np.array(self.lock_intervals) * self.h_c
         return w
 
+    def clip_lock_times(self, T):
+        """Scaled lock times moved into each scenario's lock interval."""
+        K = np.array(self.lock_intervals)
+        return np.clip(T, K * self.h_c + self.tau_min, (K + 1) * self.h_c)
 
-def _transcribe(ocp, n_s, aggregate, t_grid_end):
-    """Transcribe the robust problem of ``n_s`` scenarios on the functions of ``ocp``.
+    def scenario_times(self, T=None):
+        """Scaled (node times, point times (K+1, d)) of each scenario (at lock times T, default the
+        end of each lock interval)."""
+        K = np.array(self.lock_intervals)
+        T = (K + 1) * self.h_c if T is None else np.asarray(T, float)
+        out = []
+        for Ks, Ts in zip(K, T):
+            starts = np.append(np.arange(Ks + 1) * self.h_c, Ts)
+            steps = np.diff(starts)
+            out.append((starts, starts[:-1, None] + steps[:, None] * self.tau[None, :]))
+        return out
 
-    The NLP parameter is ``[weights (5); theta of each scenario; scenario weights (n_s)]``.
+    def interval_moves(self, w, lam_x, tol=1e-6):
+        """+1 / -1 for a scenario whose lock-up sits on the end / start of its command interval with a
+        multiplier pushing it beyond (and a next / previous interval exists), else 0."""
+        tau, lam = w[self.tau_slice], lam_x[self.tau_slice]
+        K = np.array(self.lock_intervals)
+        n_int = self.command_grid.size - 1
+        up = (tau >= self.h_c * (1 - 1e-6)) & (lam > tol) & (K < n_int - 1)
+        down = (tau <= self.tau_min * (1 + 1e-3)) & (lam < -tol) & (K > 0)
+        return up.astype(int) - down.astype(int)
+
+
+def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
+    """Transcribe the robust problem on the functions of ``ocp`` (see :class:`_RobustNLP`).
+
+    The NLP parameter is ``[weights (5); theta of each scenario; scenario weights]``.
     """
     tr, prob = ocp.transcription, ocp._staged_problem()
-    N, d = tr.intervals, tr.degree
-    n_x, n_th = prob.n_x, ocp.theta.numel()
-    M = N                                             # command steps over [0, t_max]
-    h_c = t_grid_end / M
-    grid = np.arange(M + 1) * h_c
-    X = ca.MX.sym("X", n_x, (N + 1) * n_s)
-    Xc = ca.MX.sym("Xc", n_x, N * d * n_s)
-    V = ca.MX.sym("V", M + 1)
-    T = ca.MX.sym("T", n_s)
+    d, tau = tr.degree, tr.tau
+    n_x, n_th, n_s = prob.n_x, ocp.theta.numel(), len(lock_intervals)
+    h_c = t_grid_end / n_int
+    tau_min = 1e-3 * h_c
+    grid = np.arange(n_int + 1) * h_c
+    K = np.array(lock_intervals)
+    n_nodes, n_ints = K + 2, K + 1
+    X = [ca.MX.sym(f"X{s}", n_x, int(n_nodes[s])) for s in range(n_s)]
+    Xc = [ca.MX.sym(f"Xc{s}", n_x, int(n_ints[s]) * d) for s in range(n_s)]
+    V = ca.MX.sym("V", n_int + 1)
+    tau_s = ca.MX.sym("tau", n_s)
     z = ca.MX.sym("z", 1 if aggregate == "worst" else 0)
     W = ca.MX.sym("weights", len(OBJECTIVE_TERMS))
     Theta = ca.MX.sym("theta", n_th, n_s)
     omega = ca.MX.sym("omega", n_s)
-    w = ca.veccat(X, Xc, V, T, z)
-    layout = {"x": (0, (n_s, N + 1, n_x)), "xc": (X.numel(), (n_s, N, d, n_x)), "v": (X.numel() + Xc.numel(), (M + 1,))}
-    t_start = X.numel() + Xc.numel() + M + 1
-    T_slice = slice(t_start, t_start + n_s)
-
-    # The command at absolute (scaled) time t: linear interpolation of V on the grid (hat functions).
-    t_sym, v_sym = ca.SX.sym("t"), ca.SX.sym("v", M + 1)
-    hats = ca.fmax(0, 1 - ca.fabs(t_sym / h_c - ca.DM(np.arange(M + 1))))
-    command = ca.Function("command", [t_sym, v_sym], [ca.dot(v_sym, hats)])
-
-    # Every collocation point of every scenario: its time, command and parameters, then one map.
-    s_pts = (np.arange(N)[:, None] + tr.tau[None, :]).ravel() / N            # normalised times
-    Tp = _repeat_columns(T.T, N * d)                                          # (1, n_s N d)
-    t_pts = Tp * ca.DM(np.tile(s_pts, n_s)).T
-    Uc = command.map(N * d * n_s)(t_pts, ca.repmat(V, 1, N * d * n_s))
-    P_pts = ca.vertcat(ca.repmat(W, 1, N * d * n_s), _repeat_columns(Theta, N * d))
-    xdot, q, c = prob.dynamics.map(N * d * n_s)(Xc, Uc, P_pts)
-
-    C0 = np.tile(tr.C[0], N)[None, :]
-    Cin = _sparse(np.kron(np.eye(N), tr.C[1:]))
-    Dm = _sparse(np.kron(np.eye(N), tr.D[1:, None]))
-    B = ca.DM(np.tile(tr.B, N))
-    colloc, continuity, g_end, J_s = [], [], [], []
+    w = ca.veccat(*X, *Xc, V, tau_s, z)
+    x_offsets, xc_offsets, start = [], [], 0
     for s in range(n_s):
-        Xs = X[:, s * (N + 1):(s + 1) * (N + 1)]
-        cols = slice(s * N * d, (s + 1) * N * d)
-        Xcs, h = Xc[:, cols], T[s] / N
-        colloc.append(ca.vec(_repeat_columns(Xs[:, :-1], d) * ca.DM(np.repeat(C0, n_x, axis=0))
-                             + ca.mtimes(Xcs, Cin) - h * xdot[:, cols]))
+        x_offsets.append((start, int(n_nodes[s])))
+        start += int(n_nodes[s]) * n_x
+    for s in range(n_s):
+        xc_offsets.append((start, int(n_ints[s]) * d))
+        start += int(n_ints[s]) * d * n_x
+    v_slice = slice(start, start + n_int + 1)
+    tau_slice = slice(v_slice.stop, v_slice.stop + n_s)
+
+    # Command and step at every collocation point: interval i < K_s of scenario s is command interval
+    # i (step h_c, u = V_i + (V_{i+1} - V_i) tau_j); its last interval K_s has the step tau_s and
+    # u = V_K + (V_{K+1} - V_K) tau_s tau_j / h_c.
+    left_idx, frac, step = [], [], []
+    for s in range(n_s):
+        for i in range(int(n_ints[s])):
+            left_idx += [i] * d
+            if i < K[s]:
+                frac.append(ca.DM(tau).T)
+                step.append(ca.DM.ones(1, d) * h_c)
+            else:
+                frac.append(tau_s[s] * ca.DM(tau).T / h_c)
+                step.append(ca.repmat(tau_s[s], 1, d))
+    frac, step = ca.horzcat(*frac), ca.horzcat(*step)
+    left = V[left_idx].T
+    right = V[[i + 1 for i in left_idx]].T
+    Uc = left + (right - left) * frac
+    n_pts = len(left_idx)
+    P_pts = ca.vertcat(ca.repmat(W, 1, n_pts),
+                       ca.horzcat(*[ca.repmat(Theta[:, s], 1, int(n_ints[s]) * d) for s in range(n_s)]))
+    xdot, q, c = prob.dynamics.map(n_pts)(ca.horzcat(*Xc), Uc, P_pts)
+
+    B = np.asarray(tr.B)
+    colloc, continuity, g_end, J_s = [], [], [], []
+    col = 0
+    for s in range(n_s):
+        ni = int(n_ints[s])
+        cols = slice(col, col + ni * d)
+        col += ni * d
+        Xs, Xcs = X[s], Xc[s]
+        Cin = _sparse(np.kron(np.eye(ni), tr.C[1:]))
+        Dm = _sparse(np.kron(np.eye(ni), tr.D[1:, None]))
+        C0 = np.repeat(np.tile(tr.C[0], ni)[None, :], n_x, axis=0)
+        hs = step[:, cols]
+        colloc.append(ca.vec(_repeat_columns(Xs[:, :-1], d) * ca.DM(C0) + ca.mtimes(Xcs, Cin)
+                             - ca.repmat(hs, n_x, 1) * xdot[:, cols]))
         continuity.append(ca.vec(Xs[:, 1:] - (Xs[:, :-1] * tr.D[0] + ca.mtimes(Xcs, Dm))))
-        Q = ca.mtimes(q[:, cols] * h, B)
-        u_f = command(T[s], V)
+        Q = ca.mtimes(q[:, cols] * ca.repmat(hs, q.size1(), 1), ca.DM(np.tile(B, ni)))
+        T_s = K[s] * h_c + tau_s[s]
+        u_f = V[int(K[s])] + (V[int(K[s]) + 1] - V[int(K[s])]) * tau_s[s] / h_c
         p_s = ca.vertcat(W, Theta[:, s])
-        J_s.append(prob.objective(Xs[:, -1], u_f, Q, T[s], p_s))
-        g_end.append(prob.end(Xs[:, -1], u_f, T[s], p_s))
+        J_s.append(prob.objective(Xs[:, -1], u_f, Q, T_s, p_s))
+        g_end.append(prob.end(Xs[:, -1], u_f, T_s, p_s))
     J_all = ca.vertcat(*J_s)
+    n_e = prob.end_lb.size
+    end_lb, end_ub = prob.end_lb.copy(), prob.end_ub.copy()
+    end_lb[-1], end_ub[-1] = -np.inf, np.inf                 # energy row: no e_max in the robust problem
     blocks = [(ca.vertcat(*colloc), 0.0, 0.0), (ca.vertcat(*continuity), 0.0, 0.0),
-              (ca.vec(c), np.tile(prob.c_lb, N * d * n_s), np.tile(prob.c_ub, N * d * n_s)),
-              (ca.vertcat(*g_end), np.tile(prob.end_lb, n_s), np.tile(prob.end_ub, n_s))]
+              (ca.vec(c), np.tile(prob.c_lb, n_pts), np.tile(prob.c_ub, n_pts)),
+              (ca.vertcat(*g_end), np.tile(end_lb, n_s), np.tile(end_ub, n_s))]
     if prob.u_rate is not None:
-        moves = V[1:] - V[:-1]
         limit = float(prob.u_rate[0]) * h_c
-        blocks.append((moves, -limit, limit))
+        blocks.append((V[1:] - V[:-1], -limit, limit))
     if aggregate == "worst":
         f = z
         blocks.append((J_all - z, -np.inf, 0.0))
@@ -496,27 +648,24 @@ def _transcribe(ocp, n_s, aggregate, t_grid_end):
     g = ca.vertcat(*[b[0] for b in blocks])
     lbg = np.concatenate([np.broadcast_to(b[1], (b[0].numel(),)) for b in blocks])
     ubg = np.concatenate([np.broadcast_to(b[2], (b[0].numel(),)) for b in blocks])
-    # The energy end row is unbounded (no e_max in the robust problem).
-    n_e = prob.end_lb.size
-    end_start = sum(b[0].numel() for b in blocks[:3])
-    for s in range(n_s):
-        row = end_start + s * n_e + n_e - 1
-        lbg[row], ubg[row] = -np.inf, np.inf
+    assert n_e * n_s == blocks[3][0].numel()
 
-    lbx = np.concatenate([np.tile(prob.x_lb, (N + 1) * n_s), np.tile(prob.x_lb, N * d * n_s),
-                          np.full(M + 1, prob.u_lb[0]), np.zeros(n_s), np.full(z.numel(), -np.inf)])
-    ubx = np.concatenate([np.tile(prob.x_ub, (N + 1) * n_s), np.tile(prob.x_ub, N * d * n_s),
-                          np.full(M + 1, prob.u_ub[0]), np.full(n_s, np.inf), np.full(z.numel(), np.inf)])
-    for s in range(n_s):                               # each scenario starts from the initial state
-        lbx[s * (N + 1) * n_x:s * (N + 1) * n_x + n_x] = prob.x0
-        ubx[s * (N + 1) * n_x:s * (N + 1) * n_x + n_x] = prob.x0
-    v0 = layout["v"][0]
+    n_w = w.numel()
+    lbx, ubx = np.full(n_w, -np.inf), np.full(n_w, np.inf)
+    for (a, n) in x_offsets + xc_offsets:
+        lbx[a:a + n * n_x] = np.tile(prob.x_lb, n)
+        ubx[a:a + n * n_x] = np.tile(prob.x_ub, n)
+    for a, _ in x_offsets:                                 # every scenario starts from the initial state
+        lbx[a:a + n_x] = ubx[a:a + n_x] = prob.x0
+    lbx[v_slice], ubx[v_slice] = prob.u_lb[0], prob.u_ub[0]
     if prob.u_initial is not None and prob.u_rate is not None:
-        lbx[v0] = ubx[v0] = prob.u_initial[0]         # no step at t = 0
+        lbx[v_slice.start] = ubx[v_slice.start] = prob.u_initial[0]     # no step at t = 0
+    lbx[tau_slice], ubx[tau_slice] = tau_min, h_c
     P = ca.vertcat(W, ca.vec(Theta), omega)
     nlp = {"x": w, "f": f, "g": g, "p": P}
     objectives_fn = ca.Function("scenario_objectives", [w, P], [J_all])
-    return _RobustNLP(nlp, lbx, ubx, lbg, ubg, layout, T_slice, grid, objectives_fn)
+    return _RobustNLP(nlp, lbx, ubx, lbg, ubg, x_offsets, xc_offsets, v_slice, tau_slice, n_x, d, np.asarray(tau),
+                      h_c, tuple(int(k) for k in K), grid, objectives_fn, tau_min)
 
 
 def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean", intervals=60, degree=3,
@@ -535,7 +684,7 @@ def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean"
         Objective weights by term (jerk, energy, time, jump, smooth).
     aggregate : {"mean", "worst"}
     intervals, degree : int
-        Collocation intervals (and command steps) and points per interval.
+        Steps of the command grid over [0, t_max] and collocation points per interval.
     scenario_weights : sequence of float, optional
         Weights of the scenarios in the mean.
     **ocp_options

@@ -179,6 +179,7 @@ def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MAR
         Unpacks as ``times, pressures`` (piecewise linear between the points, the last value held
         afterwards); also holds the clamp pressure, margin, locked torque and the ramp.
     """
+    margin = check_margin(margin)
     times, values = np.asarray(command_times, float), np.asarray(command, float)
     if times.size != values.size or times.size < 1 or np.any(np.diff(times) <= 0):
         raise ModelError("command: increasing times with one value each are needed")
@@ -195,4 +196,4 @@ def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MAR
     out_t = np.concatenate([times[keep], [t_lock], [t_end] if t_end > t_lock else []])
     out_p = np.concatenate([values[keep], [p_lock], [p_c] if t_end > t_lock else []])
     demand = abs(clamp.locked_torque() if locked_torque is None else float(locked_torque))
-    return ClampedCommand(out_t, out_p, p_c, check_margin(margin), demand, float(t_lock), float(t_end), rate)
+    return ClampedCommand(out_t, out_p, p_c, margin, demand, float(t_lock), float(t_end), rate)

@@ -125,10 +125,13 @@ class ParametricOCP(EngagementOCP):
                              ) from None
         finally:
             self.model = numeric
-        jump_theta = self.jump_fn
-        self.jump_fn = lambda x, u: jump_theta(x, u, self.theta_value)
+        if self.theta.numel():
+            jump_theta = self.jump_fn
+            self.jump_fn = lambda x, u: jump_theta(x, u, self.theta_value)
 
     def _evaluate(self, xs, us):
+        if not self.theta.numel():
+            return super()._evaluate(xs, us)
         n = len(us)
         values = np.array(self.outputs_fn.map(n)(np.asarray(xs).T, np.asarray(us)[None, :],
                                                  np.repeat(self.theta_value[:, None], n, axis=1)))
@@ -377,6 +380,8 @@ class RobustOCP:
             lam_x0, lam_g0 = np.zeros_like(w0), np.zeros(nlp.lbg.size)
         w0 = np.clip(w0, nlp.lbx, nlp.ubx)
         p = np.concatenate([[weights[k] for k in OBJECTIVE_TERMS], self.thetas.ravel(), omega])
+        if aggregate == "worst" and not warm:                 # the epigraph variable starts on its bound
+            w0[nlp.tau_slice.stop:] = np.max(np.array(nlp.objectives_fn(w0, p)))
         solver = self.solver(nlp, warm)
         start = time.perf_counter()
         sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg, p=p)

@@ -97,7 +97,8 @@ def _cmd_optimize(args):
     run_optimize(args.scene, out_dir=args.out, t_max=args.t_max,
                  weights=_parse_weights(args.weights) if args.weights else None,
                  intervals=args.intervals, degree=args.degree,
-                 sweep_t_max=_parse_sweep(args.sweep_t_max) if args.sweep_t_max else None)
+                 sweep_t_max=_parse_sweep(args.sweep_t_max) if args.sweep_t_max else None,
+                 clamp_margin=args.clamp_margin)
     return 0
 
 
@@ -144,6 +145,9 @@ def build_parser():
     p.add_argument("--degree", type=int, default=3, help="collocation points per interval (default: 3)")
     p.add_argument("--sweep-t-max", default=None, metavar="LIST|START:STOP:COUNT",
                    help="solve for several engagement-time limits and draw the jerk/time trade-off")
+    p.add_argument("--clamp-margin", type=float, default=1.3, metavar="RATIO",
+                   help="after lock-up, ramp to the clamp pressure whose static torque capacity is RATIO x "
+                        "the locked torque (>= 1, default: 1.3)")
     p.set_defaults(run=_cmd_optimize)
     p = sub.add_parser("bench", help="error against run time, stiffness and scaling (work-precision report)")
     p.add_argument("--quick", action="store_true", help="fewer tolerances and sizes (under 3 minutes)")

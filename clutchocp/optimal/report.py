@@ -10,16 +10,20 @@ from ..output import new_figure, save_figure, write_csv, write_summary
 from ..scene import default_scene, load_scene
 from .baselines import baseline_label, simulate_baselines
 from .bound import jerk_lower_bound
+from .clamp import DEFAULT_MARGIN, check_margin, extend_to_clamp
 from .problem import EngagementOCP
-from .replay import CommandModel
-from .verify import HOLD_DELAY, holding_pressure, run_numbers, verify
+from .replay import CommandModel, simulate_command
+from .verify import run_numbers, verify
 
 KEYS = ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral", "dissipated_energy_J", "peak_jerk_rad_s3",
         "peak_torque_Nm")
 
 
+CLAMP_SETTLE_S = 0.3       # the whole-curve replay runs this long after the clamp ramp ends
+
+
 def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, intervals=100, degree=3,
-                 sweep_t_max=None, progress=True):
+                 sweep_t_max=None, progress=True, clamp_margin=DEFAULT_MARGIN):
     """Optimal engagement pressure of a scene: solve, verify with IDAS, compare, write files.
 
     Parameters
@@ -40,6 +44,10 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         adds ``sweep`` to the summary and pareto.png).
     progress : bool
         Print progress lines (stages, sweep points) and the summary.
+    clamp_margin : float
+        Static torque capacity at the clamp pressure over the locked torque (>= 1): after lock-up
+        the command ramps at the rate limit to that clamp pressure and holds it
+        (:mod:`clutchocp.optimal.clamp`); pressure_profile.csv holds the whole curve.
 
     Returns
     -------
@@ -52,6 +60,7 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         Infeasible limits, bad weights, a scene the optimisation does not cover, IPOPT failure.
     """
     say = print if progress else (lambda *a, **k: None)
+    clamp_margin = check_margin(clamp_margin)          # a bad margin fails before the solve
     if scene is None:
         scene = default_scene()
     elif isinstance(scene, (str, Path)):
@@ -68,6 +77,10 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     check, replay = verify(verifier, opt, model=command_model)
     say(f"  IDAS re-simulation: lock-up {_fmt(check['idas']['engagement_time_s'], 's')}, "
         f"jump {_fmt(check['torque_jump_Nm'], 'N m')}")
+    curve, whole = _clamp_curve(scene, ocp, opt, command_model, clamp_margin)
+    say(f"  after lock-up: ramp to the clamp pressure {curve.clamp_pressure_Pa / 1e6:.4g} MPa by "
+        f"{curve.ramp_end_s:.4g} s (capacity {curve.margin:g} x the locked torque); lock held in the IDAS replay: "
+        f"{whole['lock_held']}")
     baselines = simulate_baselines(scene)
     w_rel0, rate0 = ocp.initial_slip()
     bound = jerk_lower_bound(w_rel0, rate0, opt.t_f)
@@ -90,6 +103,7 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
                    "rate_limit_Pa_s": ocp.rate_limit if np.isfinite(ocp.rate_limit) else None,
                    "lock_margin": ocp.lock_margin},
         "weights": opt.weights,
+        "clamp": whole,
         "solver": {"status": opt.stats["status"], "iterations": opt.stats["iterations"],
                    "wall_time_s": opt.stats["wall_time_s"], "build_time_s": build_time,
                    "intervals": intervals, "degree": degree, "scheme": ocp.transcription.scheme,
@@ -100,13 +114,47 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     if sweep is not None:
         summary["sweep"] = sweep
     out.mkdir(parents=True, exist_ok=True)
-    files = [_write_profile(out, ocp, opt), write_summary(out / "summary.json", summary)]
-    files += plot_optimum(out, scene, opt, replay, ocp.baseline, baselines, summary)
+    files = [_write_profile(out, opt, curve, whole["run"]), write_summary(out / "summary.json", _public(summary))]
+    files += plot_optimum(out, scene, opt, replay, ocp.baseline, baselines, summary, curve)
     if sweep is not None:
         files.append(plot_pareto(out, scene, sweep, w_rel0, rate0, ocp))
     summary["files"] = [str(f) for f in files]
+    summary = _public(summary)
     say(format_summary(summary))
     return summary
+
+
+def _public(summary):
+    """The summary without the replay run object (kept for the CSV and the figures)."""
+    out = dict(summary)
+    out["clamp"] = {k: v for k, v in summary["clamp"].items() if k != "run"}
+    return out
+
+
+def _clamp_curve(scene, ocp, opt, command_model, margin):
+    """The optimal command continued by the ramp to the clamp pressure, and its IDAS replay.
+
+    Returns
+    -------
+    (ClampedCommand, dict)
+        The curve and the summary entry ``clamp`` (with the replay run under ``run``).
+    """
+    rate = ocp.rate_limit if np.isfinite(ocp.rate_limit) else None
+    curve = extend_to_clamp(scene, opt.command_times, opt.command, opt.t_f, margin=margin, rate_limit=rate)
+    t_end = curve.ramp_end_s + CLAMP_SETTLE_S
+    run = simulate_command(scene, curve.times, curve.pressures, t_end, model=command_model, control="linear",
+                           points=601)
+    lock = [e.t for e in run.result.events if e.name == "lockup"]
+    unlock = [e.t for e in run.result.events if e.name == "unlock"]
+    torque = run.result["total_torque_Nm"][-1]
+    entry = {"margin": curve.margin, "clamp_pressure_Pa": curve.clamp_pressure_Pa,
+             "locked_torque_Nm": curve.locked_torque_Nm, "ramp_start_s": curve.ramp_start_s,
+             "ramp_end_s": curve.ramp_end_s, "rate_limit_Pa_s": curve.rate_limit_Pa_s,
+             "replay_end_s": t_end, "lock_time_s": lock[0] if lock else None,
+             "lock_held": bool(lock) and not unlock,
+             "capacity_margin_at_end": float(run.result["static_capacity_Nm"][-1] / torque) if lock else None,
+             "run": run}
+    return curve, entry
 
 
 def _fmt(value, unit, fmt="{:.4g}"):
@@ -139,19 +187,25 @@ def _sweep(ocp, opt, values, weights, say):
     return [results[v] for v in values]
 
 
-def _write_profile(out, ocp, opt):
-    """pressure_profile.csv: time, command and pressure [s, Pa, Pa].
+def _write_profile(out, opt, curve, run):
+    """pressure_profile.csv: the whole usable command, engagement and clamp [s, Pa, Pa].
 
-    Piecewise-linear command: its nodes (linear in between). Piecewise-constant command: the value
-    from each time on. After lock-up (the last time) the command is the holding pressure of the
-    verification (summary: verification.holding_pressure_Pa; the last row of a constant command).
+    Rows are the nodes of the piecewise-linear command: ``to_next`` says how the command goes on
+    to the next row ("linear") or after the last one ("hold": constant). ``phase`` is
+    "engagement" up to lock-up, then "clamp_ramp" and "clamp_hold". ``pressure_Pa`` is the
+    pressure the collocation predicts up to lock-up and the IDAS replay of the whole curve after it.
     """
-    times = np.append(opt.command_times, opt.t_f * (1 + HOLD_DELAY)) if opt.control == "constant" \
-        else opt.command_times.copy()
-    command = np.append(opt.command, holding_pressure(ocp, opt)) if opt.control == "constant" else opt.command
-    pressure = np.interp(times, opt.t, opt.outputs["pressure_Pa"])
+    times, command = curve.times, curve.pressures
+    engaged = times <= opt.t_f
+    pressure = np.where(engaged, np.interp(times, opt.t, opt.outputs["pressure_Pa"]),
+                        np.interp(times, run.result.t, run.result["pressure_Pa"]))
+    phase = np.where(engaged, "engagement", "clamp_ramp").astype(object)
+    if times[-1] > opt.t_f:
+        phase[-1] = "clamp_hold"
+    to_next = ["linear"] * (times.size - 1) + ["hold"]
     return write_csv(out / "pressure_profile.csv",
-                     {"time_s": times, "pressure_command_Pa": command, "pressure_Pa": pressure})
+                     {"time_s": times, "pressure_command_Pa": command, "pressure_Pa": pressure,
+                      "phase": list(phase), "to_next": to_next})
 
 
 def _slip(run):
@@ -160,7 +214,7 @@ def _slip(run):
     return res.t, (res.t <= t_lock) if t_lock is not None else np.ones(res.t.size, bool)
 
 
-def plot_optimum(out, scene, opt, replay, baseline, baselines, summary):
+def plot_optimum(out, scene, opt, replay, baseline, baselines, summary, curve=None):
     """Pressure, torque, speeds and jerk of the optimum (IDAS replay) against the baseline; baselines bar chart."""
     files = []
     name = scene.name
@@ -172,6 +226,12 @@ def plot_optimum(out, scene, opt, replay, baseline, baselines, summary):
                 where="post", color="C0", lw=0.8, alpha=0.6, label="optimal command")
     else:
         ax.plot(opt.command_times, opt.command / 1e6, color="C0", lw=0.8, alpha=0.6, label="optimal command")
+    if curve is not None:
+        after = curve.times >= opt.t_f
+        t_after = np.append(curve.times[after], 10.0 * curve.times[-1])
+        p_after = np.append(curve.pressures[after], curve.pressures[-1])
+        ax.plot(t_after, p_after / 1e6, color="C2", lw=1.2, ls="--",
+                label=f"command after lock-up: ramp to clamp ({curve.margin:g} x locked torque)")
     for label, run, color in runs:
         ax.plot(run.result.t, run.result["pressure_Pa"] / 1e6, color=color, label=label)
     ax.plot(opt.t, opt.outputs["pressure_Pa"] / 1e6, ".", color="C0", ms=2, label="collocation")

@@ -191,15 +191,16 @@ def _write_profile(out, opt, curve, run):
     """pressure_profile.csv: the whole usable command, engagement and clamp [s, Pa, Pa].
 
     Rows are the nodes of the piecewise-linear command: ``to_next`` says how the command goes on
-    to the next row ("linear") or after the last one ("hold": constant). ``phase`` is
-    "engagement" up to lock-up, then "clamp_ramp" and "clamp_hold". ``pressure_Pa`` is the
+    to the next row ("linear") or after the last one ("hold": constant). ``phase`` names the
+    segment a row starts: "engagement" before lock-up, "clamp_ramp" from the lock-up row,
+    "clamp_hold" on the last row. ``pressure_Pa`` is the
     pressure the collocation predicts up to lock-up and the IDAS replay of the whole curve after it.
     """
     times, command = curve.times, curve.pressures
     engaged = times <= opt.t_f
     pressure = np.where(engaged, np.interp(times, opt.t, opt.outputs["pressure_Pa"]),
                         np.interp(times, run.result.t, run.result["pressure_Pa"]))
-    phase = np.where(engaged, "engagement", "clamp_ramp").astype(object)
+    phase = np.where(times < opt.t_f, "engagement", "clamp_ramp").astype(object)   # the segment a row starts
     if times[-1] > opt.t_f:
         phase[-1] = "clamp_hold"
     to_next = ["linear"] * (times.size - 1) + ["hold"]

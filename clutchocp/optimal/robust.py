@@ -49,6 +49,7 @@ from .problem import OBJECTIVE_TERMS, EngagementOCP, OptimalEngagement, check_we
 from .replay import simulate_command
 
 AGGREGATES = ("mean", "worst")
+PRESOLVE_INTERVALS = 10
 
 
 class ParametricScene:
@@ -226,6 +227,7 @@ class RobustOCP:
         self.names, self.scenes = _check_scenarios(scene, scenarios)
         self.overrides = [dict(d) for d in scenarios]
         self.ocp = ParametricOCP(scene, self.names, intervals=intervals, degree=degree, **ocp_options)
+        self._ocp_options = dict(ocp_options, degree=degree)
         self.thetas = np.array([self.ocp.nominal_theta(s) for s in self.scenes]).reshape(len(self.scenes), -1)
         self.intervals = int(intervals)
         self._nlps = {}
@@ -272,7 +274,8 @@ class RobustOCP:
         return self._solvers[key]
 
     # -- solving ------------------------------------------------------------------------------
-    def solve(self, *, t_max=None, weights=None, aggregate="mean", scenario_weights=None, max_shifts=12):
+    def solve(self, *, t_max=None, weights=None, aggregate="mean", scenario_weights=None, max_shifts=12,
+              presolve_intervals=PRESOLVE_INTERVALS):
         """Solve for the robust command (smooth stage, then the polish on the exact forms).
 
         Parameters
@@ -287,7 +290,11 @@ class RobustOCP:
         scenario_weights : sequence of float, optional
             Weights of the scenarios in the mean (normalised; default equal).
         max_shifts : int
-            Largest number of re-solves that move a scenario's lock-up into the next command interval.
+            Largest number of re-solves per stage that move a scenario's lock-up into the next command interval.
+        presolve_intervals : int or None
+            First solve the problem on this coarser command grid (smooth model only), where a
+            re-solve moves a lock-up by a longer step, and start from its lock-up times and states
+            (None, or not fewer than ``intervals``: start from the scenarios' baseline runs).
 
         Returns
         -------
@@ -319,8 +326,16 @@ class RobustOCP:
             raise ModelError(f"t_max = {t_max:.4g} s is below the fastest lock-up of scenarios[{k}] "
                              f"{self.overrides[k]} ({fastest[k]:.4g} s with a step to actuation.max_pressure); "
                              "raise t_max or the pressure limit")
-        stages = []
-        result = self._solve_model(ocp, t_max, weights, aggregate, omega, None, max_shifts, stages, "smooth")
+        stages, start = [], None
+        if presolve_intervals is not None and presolve_intervals < self.intervals:
+            coarse = RobustOCP(self.scene, self.overrides, intervals=presolve_intervals,
+                               **dict(self._ocp_options, polish=False, baseline=ocp.baseline))
+            coarse._runs, coarse._fastest = self._baseline_runs(), fastest
+            start = coarse._solve_model(coarse.ocp, t_max, weights, aggregate, omega, None, max_shifts, stages,
+                                        f"smooth, {presolve_intervals} intervals")
+            if not start.success:
+                start = None
+        result = self._solve_model(ocp, t_max, weights, aggregate, omega, start, max_shifts, stages, "smooth")
         if ocp.polish and result.success:
             polished = self._solve_model(ocp.exact, t_max, weights, aggregate, omega, result, max_shifts, stages,
                                          "exact")
@@ -674,7 +689,7 @@ def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
 
 
 def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean", intervals=60, degree=3,
-                 scenario_weights=None, **ocp_options):
+                 scenario_weights=None, presolve_intervals=PRESOLVE_INTERVALS, **ocp_options):
     """One pressure command for several scenarios of a clutch (see the module notes).
 
     Parameters
@@ -692,6 +707,8 @@ def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean"
         Steps of the command grid over [0, t_max] and collocation points per interval.
     scenario_weights : sequence of float, optional
         Weights of the scenarios in the mean.
+    presolve_intervals : int or None
+        Command steps of the coarse first solve that finds the lock-up intervals (see :meth:`RobustOCP.solve`).
     **ocp_options
         Options of :class:`~clutchocp.optimal.problem.EngagementOCP`.
 
@@ -700,4 +717,5 @@ def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean"
     RobustEngagement
     """
     problem = RobustOCP(scene, scenarios, intervals=intervals, degree=degree, **ocp_options)
-    return problem.solve(t_max=t_max, weights=weights, aggregate=aggregate, scenario_weights=scenario_weights)
+    return problem.solve(t_max=t_max, weights=weights, aggregate=aggregate, scenario_weights=scenario_weights,
+                         presolve_intervals=presolve_intervals)

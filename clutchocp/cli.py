@@ -28,13 +28,20 @@ def _cmd_scenes(args):
 
 
 def _describe(scene):
-    """Print a checked scene: its parts and their chosen variants."""
+    """Print a checked scene: its parts, their chosen variants and its uncertain fields."""
+    from .uncertainty import Uncertainty
+
+    uncertainty = Uncertainty.from_scene(scene)
     print(f"{scene.name}: {scene.kind} scene, valid")
     print(f"  source: {scene.source}")
     for part in scene.parts:
         if part != "scene":
             variant = scene.variant(part)
             print(f"  [{part}]" + (f" model = {variant}" if variant else ""))
+    if uncertainty:
+        print("  [uncertainty]")
+        for line in uncertainty.describe():
+            print(f"    {line}")
 
 
 def _cmd_validate(args):

@@ -24,6 +24,9 @@ from ..errors import (
 from ..units import to_si
 from .schema import CHECKS, PARTS, REQUIRED_PARTS
 
+# The table of a scene that declares its uncertain fields (see clutchocp.uncertainty), not a part.
+UNCERTAINTY = "uncertainty"
+
 # Parts each static analysis reads.
 ANALYSIS_PARTS = {
     "chen2021_pack": ("spline", "friction", "operating"),
@@ -92,7 +95,7 @@ def _check_value(name, value, spec, unit_hint):
         raise PhysicalRangeError(f"{name} = {value:g}{unit_hint}: must be {phrase}")
 
 
-def _parse_field(name, raw, spec):
+def parse_field(name, raw, spec):
     """Convert one raw TOML value to its SI value, or raise a one-line SceneError."""
     unit_hint = "" if spec.dim == "1" else f" (SI, {spec.dim})"
     if spec.kind == "quantity":
@@ -165,7 +168,7 @@ def _validate_part(part_name, table):
     for key, spec in allowed.items():
         name = f"{part_name}.{key}"
         if key in table:
-            values[key] = _parse_field(name, table[key], spec)
+            values[key] = parse_field(name, table[key], spec)
         elif spec.required:
             raise MissingParameterError(f"{name}: missing required parameter ({spec.doc})")
         elif spec.default is not None:
@@ -254,6 +257,7 @@ class Scene:
     def __init__(self, raw, path=None):
         self.raw = raw
         self.path = Path(path) if path else None
+        self._uncertainty = None
         try:
             self._values = validate(raw, self.path.parent if self.path else Path.cwd())
         except SceneError as exc:
@@ -318,6 +322,27 @@ class Scene:
                 raw.setdefault(part, {})[key] = value
         return Scene(raw, self.path)
 
+    @property
+    def uncertainty(self):
+        """The spread of the clutches this scene stands for (:class:`clutchocp.uncertainty.Uncertainty`,
+        empty if the scene has no ``[uncertainty]`` table). Read when first asked for, so that a
+        deterministic run of a scene whose overrides change a part (e.g. ``load.model``) does not
+        depend on it; studies that use it check it first (``Uncertainty.from_scene``)."""
+        if self._uncertainty is None:
+            from ..uncertainty import Uncertainty
+
+            try:
+                self._uncertainty = Uncertainty.from_scene(self, check=False)
+            except SceneError as exc:
+                raise type(exc)(f"{self.path.name}: {exc}" if self.path else str(exc)) from None
+        return self._uncertainty
+
+    def without_uncertainty(self):
+        """The same scene without its ``[uncertainty]`` table (one deterministic clutch)."""
+        if UNCERTAINTY not in self.raw:
+            return self
+        return Scene({part: table for part, table in self.raw.items() if part != UNCERTAINTY}, self.path)
+
     def __repr__(self):
         return f"Scene({self.name!r}, kind={self.kind!r}, parts={list(self.parts)})"
 
@@ -326,9 +351,11 @@ def validate(raw, base_dir):
     """Validate a parsed scene dictionary; return {part: {key: SI value}}."""
     if not isinstance(raw, dict):
         raise ParameterTypeError("scene: expected TOML tables")
+    raw = {part: table for part, table in raw.items() if part != UNCERTAINTY}
     for part in raw:
         if part not in PARTS:
-            raise UnknownKeyError(f"[{part}]: unknown part{_suggest(part, PARTS)} (allowed: {', '.join(PARTS)})")
+            raise UnknownKeyError(f"[{part}]: unknown part{_suggest(part, PARTS)} "
+                                  f"(allowed: {', '.join(PARTS)}, {UNCERTAINTY})")
     if "scene" not in raw:
         raise MissingParameterError("[scene]: missing part (name, source and kind are required)")
     values = {part: _validate_part(part, table) for part, table in raw.items()}

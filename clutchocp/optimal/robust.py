@@ -8,18 +8,31 @@ T_s <= t_max, and minimises the mean (or the worst, by an epigraph variable z >=
 scenarios' objectives J_s (the terms of :mod:`clutchocp.optimal.problem`: jerk, jump, smooth, ...).
 
 How the scenarios share the command. A scenario that locks earlier sees only the start of the
-command; its lock-up time is free. The command is therefore a function of absolute time: a
-continuous piecewise-linear function on a common grid of ``intervals`` equal steps over [0, t_max]
-(the pressure and rate bounds are then linear constraints on its node values). Each scenario keeps
-the collocation mesh of the nominal problem on its own [0, T_s] (time scaled by T_s, as in
-:mod:`clutchocp.optimal.collocation`), and the command at a collocation point at absolute time
-t = T_s s_j is the command's linear interpolation there. The other way, a command per scenario mesh
-tied together by equality constraints, needs the interpolation as well (the meshes differ whenever
-the lock times do) and adds one copy of the command per scenario. With one scenario that locks at
-t_max (the jerk-optimal engagement uses all the time it may) the command grid and the mesh coincide
-and the problem is the nominal one (checked in tests/test_optimal_robust.py). The interpolation is
-continuous but its derivative in T_s jumps where a collocation point crosses a command node; IPOPT
-meets that only as a kink of measure zero (measured: the solves converge; see the README).
+command, and its lock-up time is free, so the command is a function of absolute time: continuous
+and piecewise linear on a common grid of ``intervals`` equal steps h_c over [0, t_max] (it holds
+its last value afterwards; its pressure and rate bounds are linear constraints on the node values).
+Each scenario's collocation mesh is aligned with that grid: scenario s locks in command interval
+K_s, its mesh is the K_s full command intervals plus a last interval of free length tau_s in
+(0, h_c], and T_s = K_s h_c + tau_s. On a full interval the command is linear between two node
+values with fixed weights; on the last one it is V_K + (V_K+1 - V_K) tau_s tau_j / h_c, smooth in
+tau_s. So the NLP is smooth in every lock time. The two other ways were tried or weighed first: a
+mesh scaled by T_s on which the command is interpolated makes the NLP only continuous in T_s (its
+derivative jumps whenever a collocation point crosses a command node; measured on three corner
+scenarios, 20 intervals: IPOPT cycled for 300 iterations without converging, and the dense
+interpolation made every iteration slow), and one command copy per scenario needs the same
+interpolation to tie the copies together. The price of the aligned mesh is that the interval a
+scenario locks in is discrete: after a solve, a scenario whose tau_s sits on a bound of its
+interval with a multiplier pushing beyond it moves to the next interval and the problem is solved
+again from the last solution (a coarse presolve on 10 command steps finds the intervals first, so
+the fine grid needs few such re-solves). With one scenario that locks at t_max (the jerk optimum
+uses all the time it may) the mesh is the nominal problem's and so is the optimum (checked in
+tests/test_optimal_robust.py).
+
+Lock-up torque jump: each scenario may meet the nominal jump condition (``jump="constraint"``, the
+default of :class:`~clutchocp.optimal.problem.EngagementOCP`), but one command can rarely make
+every scenario lock tangentially (measured: infeasible on three corners of the default box), so the
+robust use is ``jump="penalty"`` with a ``jump`` weight: the jump of every scenario is an
+objective term.
 
 One dynamics function for all scenarios. The uncertain scene values are symbols of the model
 (:class:`ParametricScene`): :class:`ParametricOCP` builds the scaled dynamics, objective and end
@@ -30,7 +43,7 @@ the number of scenarios. Scales, state groups and the initial state are those of
 
 Stages: as for the nominal problem, first the smooth forms of the switching laws, then a warm-started
 polish on the exact forms. Derivatives: CasADi's automatic differentiation of the NLP graph (the
-structured assembly of :mod:`clutchocp.optimal.derivatives` assumes a command on the mesh).
+structured assembly of :mod:`clutchocp.optimal.derivatives` assumes one scenario on a uniform mesh).
 """
 
 import time

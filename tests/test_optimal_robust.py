@@ -9,7 +9,7 @@ from clutchocp.optimal.problem import SLIP_MODE, EngagementOCP
 from clutchocp.optimal.robust import ParametricOCP, RobustOCP, solve_robust
 from clutchocp.scene import default_scene
 
-N = 12
+N = 10                # no coarse presolve (PRESOLVE_INTERVALS) below this
 
 
 @pytest.fixture(scope="module")
@@ -114,7 +114,7 @@ def test_bad_requests_are_model_errors(scene, nominal):
     with pytest.raises(ModelError, match="scenarios"):
         RobustOCP(scene, [], intervals=N)
     with pytest.raises(ModelError, match="numeric"):
-        RobustOCP(scene, [{"friction.model": "stribeck"}], intervals=N)
+        RobustOCP(scene, [{"film.flow_factor": "none"}], intervals=N)
     problem = RobustOCP(scene, [{"friction.mu": 0.12}], intervals=N, baseline=ocp.baseline)
     with pytest.raises(ModelError, match="aggregate"):
         problem.solve(aggregate="median")

@@ -1,7 +1,7 @@
 """Robust feedforward: solve time against the number of scenarios, and the corner replay.
 
-The uncertainty box of the default scene: friction.mu +-10 %, oil.viscosity +-30 %, load.torque
-+-20 % (uniform). Scenario sets: 1 = the centre; 3 = centre and the two extreme corners (all low,
+The uncertainty box the default scene declares ([uncertainty]: friction.mu +-10 %, oil.viscosity
++-30 %, load.torque +-20 %, uniform), as ``scene.uncertainty`` gives it. Scenario sets: 1 = the centre; 3 = centre and the two extreme corners (all low,
 all high); 5 = centre and four corners that differ pairwise in two fields; 9 = the 8 corners and
 the centre.
 
@@ -20,7 +20,6 @@ Run from the repository root:
 """
 
 import argparse
-import itertools
 import json
 import sys
 import time
@@ -35,15 +34,12 @@ from clutchocp.optimal.replay import CommandModel, simulate_command
 from clutchocp.output import new_figure, save_figure
 from clutchocp.scene import default_scene
 
-BOX = {"friction.mu": 0.10, "oil.viscosity": 0.30, "load.torque": 0.20}     # relative half-widths
-
-
 def box_points(scene):
-    """(corners, centre) of the uncertainty box as override dicts [SI]."""
-    centre = {name: scene.value(name) for name in BOX}
-    corners = [{name: centre[name] * (1 + sign * BOX[name]) for name, sign in zip(BOX, signs)}
-               for signs in itertools.product((-1, 1), repeat=len(BOX))]
-    return corners, centre
+    """(corners, centre) of the scene's uncertainty box as override dicts [SI]."""
+    box = scene.uncertainty
+    if not box.names:
+        sys.exit(f"scene '{scene.name}' declares no [uncertainty]")
+    return box.corners(), box.centre()
 
 
 def scenario_set(scene, count):
@@ -75,7 +71,8 @@ def replay_numbers(run, t_max):
 
 def label(overrides, centre):
     return " ".join(f"{name.split('.')[-1]}{'+' if overrides[name] > centre[name] else '-'}"
-                    if not np.isclose(overrides[name], centre[name]) else f"{name.split('.')[-1]}0" for name in BOX)
+                    if not np.isclose(overrides[name], centre[name]) else f"{name.split('.')[-1]}0"
+                    for name in centre)
 
 
 def acceptance(scene, intervals, jump_weight, out):

@@ -1,9 +1,9 @@
 """Robust feedforward: solve time against the number of scenarios, and the corner replay.
 
 The uncertainty box the default scene declares ([uncertainty]: friction.mu +-10 %, oil.viscosity
-+-30 %, load.torque +-20 %, uniform), as ``scene.uncertainty`` gives it. Scenario sets: 1 = the centre; 3 = centre and the two extreme corners (all low,
-all high); 5 = centre and four corners that differ pairwise in two fields; 9 = the 8 corners and
-the centre.
++-30 %, load.torque +-20 %, uniform), as ``scene.uncertainty`` gives it. Scenario sets: 1 = the
+centre; 3 = centre and the two extreme corners (all low, all high); 5 = centre and four corners
+that differ pairwise in two fields; 9 = the 8 corners and the centre.
 
 Timing (``--scenarios``): for each set, the build (scenario scenes, their baseline and fastest
 IDAS runs, the parametric model) and the solve (coarse presolve, re-solves that move lock-ups

@@ -55,7 +55,7 @@ import numpy as np
 from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
-from .collocation import DirectCollocation, _repeat_columns, _sparse
+from .collocation import _repeat_columns, _sparse
 from .derivatives import IPOPT_OPTIONS, WARM_OPTIONS
 from .guess import guess_from_run
 from .problem import OBJECTIVE_TERMS, EngagementOCP, OptimalEngagement, check_weights

@@ -9,14 +9,14 @@ Timing (``--scenarios``): for each set, the build (scenario scenes, their baseli
 IDAS runs, the parametric model) and the solve (coarse presolve, re-solves that move lock-ups
 between command intervals, exact polish) [s], with IPOPT iterations.
 
-Acceptance (``--acceptance``): the 9-scenario robust command, the nominal optimum and the scene's
+Acceptance (``--acceptance 9``): the robust command of a scenario set, the nominal optimum and the scene's
 own baseline profile, each replayed with IDAS at the 8 corners and the centre: lock-up time and
 torque jump at lock-up per corner; figures corner_jumps.png and commands.png in ``--out``.
 
 Run from the repository root:
 
     python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 30] [--jump-weight 100]
-        [--acceptance] [--out out/bench_robust] [--json FILE]
+        [--acceptance SCENARIOS] [--out out/bench_robust] [--json FILE]
 """
 
 import argparse
@@ -75,11 +75,11 @@ def label(overrides, centre):
                     for name in centre)
 
 
-def acceptance(scene, intervals, jump_weight, out):
+def acceptance(scene, intervals, jump_weight, out, count=9):
     corners, centre = box_points(scene)
-    problem, robust, build, total = solve(scene, corners + [centre], intervals, jump_weight)
+    problem, robust, build, total = solve(scene, scenario_set(scene, count), intervals, jump_weight)
     t_max = robust.t_max
-    print(f"robust (9 scenarios, {intervals} intervals): build {build:.1f} s, solve {total:.1f} s, "
+    print(f"robust ({count} scenarios, {intervals} intervals): build {build:.1f} s, solve {total:.1f} s, "
           f"{robust.stats['iterations']} iterations", file=sys.stderr)
     nominal = EngagementOCP(scene, intervals=intervals, baseline=problem.ocp.baseline).solve(t_max=t_max)
     rows = []
@@ -94,7 +94,8 @@ def acceptance(scene, intervals, jump_weight, out):
                "robust_optimum": replay_numbers(simulate_command(s, robust.command_times, robust.command, t_end,
                                                                  model=model, control="linear"), t_max)}
         rows.append(row)
-    summary = {"t_max_s": t_max, "intervals": intervals, "jump_weight": jump_weight, "corners": rows,
+    summary = {"t_max_s": t_max, "intervals": intervals, "jump_weight": jump_weight, "scenarios": count,
+               "robust_build_s": build, "corners": rows,
                "robust_solve_s": total, "robust_iterations": robust.stats["iterations"],
                "robust_collocation_jumps_Nm": [s.terms["lockup_torque_jump_Nm"] for s in robust.scenarios],
                "robust_collocation_lock_times_s": robust.lock_times.tolist()}
@@ -103,15 +104,15 @@ def acceptance(scene, intervals, jump_weight, out):
         summary[key] = {"all_lock_within_t_max": all(r[key]["locks_within_t_max"] for r in rows),
                         "worst_abs_jump_Nm": max(jumps) if jumps else None,
                         "locked": sum(r[key]["lock_time_s"] is not None for r in rows)}
-    plot(out, scene, rows, robust, nominal, problem, t_max)
+    plot(out, scene, rows, robust, nominal, problem, t_max, count)
     return summary
 
 
-def plot(out, scene, rows, robust, nominal, problem, t_max):
+def plot(out, scene, rows, robust, nominal, problem, t_max, count):
     out.mkdir(parents=True, exist_ok=True)
     names = [r["corner"] for r in rows]
     strategies = (("baseline", "baseline (scene profile)", "C3"), ("nominal_optimum", "nominal optimum", "C1"),
-                  ("robust_optimum", "robust optimum (9 scenarios)", "C0"))
+                  ("robust_optimum", f"robust optimum ({count} scenarios)", "C0"))
     fig, (ax1, ax2) = new_figure(2, width=5.5)
     x = np.arange(len(rows))
     for k, (key, text, color) in enumerate(strategies):
@@ -148,7 +149,8 @@ def main():
     parser.add_argument("--scenarios", type=int, nargs="*", default=[1, 3, 5, 9])
     parser.add_argument("--intervals", type=int, default=30)
     parser.add_argument("--jump-weight", type=float, default=100.0)
-    parser.add_argument("--acceptance", action="store_true", help="replay the 9-scenario optimum at the corners")
+    parser.add_argument("--acceptance", type=int, default=None, metavar="SCENARIOS",
+                        help="solve with this scenario set (1, 3, 5, 9) and replay at the 9 box points")
     parser.add_argument("--out", default="out/bench_robust")
     parser.add_argument("--json", help="also write the results to this JSON file")
     args = parser.parse_args()
@@ -161,8 +163,8 @@ def main():
                "solves": len(result.stats["stages"]), "objective": result.objective}
         report["timing"].append(row)
         print(f"{count:9d} {build:10.1f} {total:10.1f} {row['iterations']:10d} {row['solves']:9d}", flush=True)
-    if args.acceptance:
-        acc = acceptance(scene, args.intervals, args.jump_weight, Path(args.out))
+    if args.acceptance is not None:
+        acc = acceptance(scene, args.intervals, args.jump_weight, Path(args.out), args.acceptance)
         report["acceptance"] = acc
         print(f"t_max = {acc['t_max_s']:.4f} s")
         print(f"{'corner':>26s} | {'baseline':>18s} | {'nominal optimum':>18s} | {'robust optimum':>18s}")

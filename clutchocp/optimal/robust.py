@@ -30,9 +30,9 @@ tests/test_optimal_robust.py).
 
 Lock-up torque jump: each scenario may meet the nominal jump condition (``jump="constraint"``, the
 default of :class:`~clutchocp.optimal.problem.EngagementOCP`), but one command can rarely make
-every scenario lock tangentially (measured: infeasible on three corners of the default box), so the
-robust use is ``jump="penalty"`` with a ``jump`` weight: the jump of every scenario is an
-objective term.
+every scenario lock tangentially (measured: infeasible on the centre and the two extreme corners
+of the default box), so the robust use is ``jump="penalty"`` with a ``jump`` weight: the jump of
+every scenario is an objective term.
 
 One dynamics function for all scenarios. The uncertain scene values are symbols of the model
 (:class:`ParametricScene`): :class:`ParametricOCP` builds the scaled dynamics, objective and end

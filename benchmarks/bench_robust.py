@@ -112,7 +112,7 @@ def plot(out, scene, rows, robust, nominal, problem, t_max, count):
     out.mkdir(parents=True, exist_ok=True)
     names = [r["corner"] for r in rows]
     strategies = (("baseline", "baseline (scene profile)", "C3"), ("nominal_optimum", "nominal optimum", "C1"),
-                  ("robust_optimum", f"robust optimum ({count} scenarios)", "C0"))
+                  ("robust_optimum", f"robust optimum (solved on {count} scenarios)", "C0"))
     fig, (ax1, ax2) = new_figure(2, width=5.5)
     x = np.arange(len(rows))
     for k, (key, text, color) in enumerate(strategies):
@@ -124,7 +124,7 @@ def plot(out, scene, rows, robust, nominal, problem, t_max, count):
             if np.isnan(value):
                 ax2.text(i + (k - 1) * 0.27, 0.01, "no lock", rotation=90, fontsize=6, ha="center", va="bottom")
     ax2.axhline(t_max, color="k", ls="--", lw=0.8, label=f"t_max = {t_max:.3f} s")
-    ax1.set(ylabel="|torque jump at lock-up| [N m]", title="IDAS replay at the box corners")
+    ax1.set(ylabel="|torque jump at lock-up| [N m]", title="IDAS replay at the 8 box corners and the centre")
     ax2.set(ylabel="lock-up time [s]", title="lock-up time (same replays)")
     for ax in (ax1, ax2):
         ax.set_xticks(x, names, rotation=60, fontsize=7)
@@ -133,7 +133,7 @@ def plot(out, scene, rows, robust, nominal, problem, t_max, count):
 
     fig, (ax,) = new_figure()
     ax.plot(nominal.command_times, nominal.command / 1e6, color="C1", label="nominal optimum (command)")
-    ax.plot(robust.command_times, robust.command / 1e6, color="C0", label="robust optimum (command)")
+    ax.plot(robust.command_times, robust.command / 1e6, color="C0", label=f"robust optimum, {count} scenarios (command)")
     base = problem.ocp.baseline.result
     ax.plot(base.t, base["pressure_Pa"] / 1e6, color="C3", lw=0.8, label="baseline (pressure, centre)")
     for t_lock in robust.lock_times:

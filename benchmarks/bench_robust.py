@@ -55,7 +55,6 @@ def solve(scene, scenarios, intervals, jump_weight):
     start = time.perf_counter()
     problem = RobustOCP(scene, scenarios, intervals=intervals, jump="penalty")
     problem.fastest_lockups()
-    problem._baseline_runs()
     build = time.perf_counter() - start
     start = time.perf_counter()
     result = problem.solve(weights={"jump": jump_weight})

@@ -53,7 +53,6 @@ import casadi as ca
 import numpy as np
 
 from ..engagement.model import EngagementModel
-from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
 from .collocation import _repeat_columns, _sparse
 from .derivatives import IPOPT_OPTIONS, WARM_OPTIONS
@@ -246,7 +245,6 @@ class RobustOCP:
         self._nlps = {}
         self._solvers = {}
         self._fastest = None
-        self._runs = None
 
     @property
     def n_scenarios(self):
@@ -287,7 +285,7 @@ class RobustOCP:
         return self._solvers[key]
 
     # -- solving ------------------------------------------------------------------------------
-    def solve(self, *, t_max=None, weights=None, aggregate="mean", scenario_weights=None, max_shifts=12,
+    def solve(self, *, t_max=None, weights=None, aggregate="mean", scenario_weights=None, max_shifts=40,
               presolve_intervals=PRESOLVE_INTERVALS):
         """Solve for the robust command (smooth stage, then the polish on the exact forms).
 
@@ -343,7 +341,7 @@ class RobustOCP:
         if presolve_intervals is not None and presolve_intervals < self.intervals:
             coarse = RobustOCP(self.scene, self.overrides, intervals=presolve_intervals,
                                **dict(self._ocp_options, polish=False, baseline=ocp.baseline))
-            coarse._runs, coarse._fastest = self._baseline_runs(), fastest
+            coarse._fastest = fastest
             start = coarse._solve_model(coarse.ocp, t_max, weights, aggregate, omega, None, max_shifts, stages,
                                         f"smooth, {presolve_intervals} intervals")
             if not start.success:
@@ -381,23 +379,39 @@ class RobustOCP:
             result = self._solve_stage(ocp, nlp, t_max, weights, aggregate, omega, guess if warm else None,
                                        result or guess, warm)
             stages.append(dict(result.stats, model=label))
-            if not result.success:
-                return result
-            moves = nlp.interval_moves(result.w, result.lam_x)
+            # A lock-up interval no command meets shows as a local infeasibility, with the lock-up
+            # of the scenario at fault on a bound of its interval: move it there and solve again.
+            last = result
+            moves = nlp.interval_moves(result.w, result.lam_x, stuck=not result.success)
             if not np.any(moves):
                 break
             lock_intervals = lock_intervals + moves
-        return result
+            if not result.success:
+                result = None
+        return result if result is not None else last
+
+    def start_runs(self, t_max):
+        """IDAS runs of every scenario under the start command: a ramp over the first command step
+        to the pressure limit, then held (cached per t_max).
+
+        The grid represents that command exactly, so the lock-up intervals it gives can be met:
+        the start is feasible. (Starting from the scenarios' own baseline runs put a fast and a
+        slow corner into the same last interval, which no command meets: measured, IPOPT reported
+        the 9-point box infeasible; a step at t = 0, which the rate limit on the grid does not
+        allow, gave lock-ups the grid cannot reach as soon.) Re-solves then move the lock-ups later.
+        """
+        key = float(t_max)
+        if getattr(self, "_start_key", None) != key:
+            h_c = t_max / self.intervals
+            times, values = [0.0, h_c], [self.ocp.scene.value("actuation.initial_pressure"), self.ocp.p_max]
+            self._start_runs = [simulate_command(s, times, values, 2.0 * t_max, control="linear") for s in self.scenes]
+            self._start_key = key
+            self._start_command = (times, values)
+        return self._start_runs
 
     def _lock_guess(self, t_max):
-        """First guess of each scenario's lock-up [s]: its baseline run's, no later than t_max."""
-        runs = self._baseline_runs()
-        return np.array([min(r.summary["engagement_time_s"] or t_max, t_max) for r in runs])
-
-    def _baseline_runs(self):
-        if self._runs is None:
-            self._runs = [simulate_engagement(s) for s in self.scenes]
-        return self._runs
+        """First guess of each scenario's lock-up [s]: under the start command (:meth:`start_runs`)."""
+        return np.array([min(r.summary["engagement_time_s"] or t_max, t_max) for r in self.start_runs(t_max)])
 
     def _solve_stage(self, ocp, nlp, t_max, weights, aggregate, omega, warm_from, start_from, warm):
         sc = ocp.scales
@@ -425,12 +439,9 @@ class RobustOCP:
 
     def _guess(self, ocp, nlp, t_max, previous):
         """Start point: a previous robust solution interpolated onto this mesh, or each scenario's
-        own baseline run (compressed to t_max if slower) with the nominal baseline's command."""
+        run under a step of the command to the pressure limit (see :meth:`_lock_guess`)."""
         sc = ocp.scales
-        if previous is not None:
-            t_lock = previous.lock_times
-        else:
-            t_lock = np.array([min(r.summary["engagement_time_s"] or t_max, t_max) for r in self._baseline_runs()])
+        t_lock = previous.lock_times if previous is not None else self._lock_guess(t_max)
         T = nlp.clip_lock_times(t_lock / sc.time_s)
         times = nlp.scenario_times(T)                           # scaled node / point times per scenario
         xs, xcs = [], []
@@ -448,15 +459,15 @@ class RobustOCP:
             v = np.interp(nlp.command_grid, previous.command_times / sc.time_s, previous.command / sc.pressure_Pa)
             return nlp.pack(xs, xcs, v, T)
         tr = ocp.transcription
-        for k, run in enumerate(self._baseline_runs()):
+        for k, run in enumerate(self.start_runs(t_max)):
             parts = ocp.nlp.unpack(guess_from_run(ocp, run, t_max=t_max))
             t_run = tr.node_times(parts["T"])[0]
             xcol = [np.stack([np.interp(t, t_run, parts["x"][:, i]) for i in range(parts["x"].shape[1])], axis=-1)
                     for t in times[k]]
             xs.append(xcol[0])
             xcs.append(xcol[1])
-        base = ocp.nlp.unpack(guess_from_run(ocp, ocp.reference_run, t_max=t_max))
-        v = np.interp(nlp.command_grid, tr.node_times(base["T"])[0], base["u"][:, 0])
+        times_c, values_c = self._start_command
+        v = np.interp(nlp.command_grid * sc.time_s, times_c, values_c) / sc.pressure_Pa
         return nlp.pack(xs, xcs, v, T)
 
     def _result(self, ocp, nlp, w, lam_x, lam_g, objective, p, weights, aggregate, omega, t_max, stats, sc):
@@ -577,14 +588,19 @@ class _RobustNLP:
             out.append((starts, starts[:-1, None] + steps[:, None] * self.tau[None, :]))
         return out
 
-    def interval_moves(self, w, lam_x, tol=1e-6):
+    def interval_moves(self, w, lam_x, tol=1e-6, stuck=False):
         """+1 / -1 for a scenario whose lock-up sits on the end / start of its command interval with a
-        multiplier pushing it beyond (and a next / previous interval exists), else 0."""
+        multiplier pushing it beyond (and a next / previous interval exists), else 0.
+
+        ``stuck``: the solve failed; move every lock-up that sits on a bound (multipliers ignored).
+        """
         tau, lam = w[self.tau_slice], lam_x[self.tau_slice]
         K = np.array(self.lock_intervals)
         n_int = self.command_grid.size - 1
-        up = (tau >= self.h_c * (1 - 1e-6)) & (lam > tol) & (K < n_int - 1)
-        down = (tau <= self.tau_min * (1 + 1e-3)) & (lam < -tol) & (K > 0)
+        at_end = tau >= self.h_c * (1 - (1e-3 if stuck else 1e-6))
+        at_start = tau <= self.tau_min + (1e-3 * self.h_c if stuck else 1e-3 * self.tau_min)
+        up = at_end & ((lam > tol) | stuck) & (K < n_int - 1)
+        down = at_start & ((lam < -tol) | stuck) & (K > 0)
         return up.astype(int) - down.astype(int)
 
 

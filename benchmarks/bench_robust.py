@@ -16,7 +16,7 @@ torque jump at lock-up per corner; figures corner_jumps.png and commands.png in 
 Run from the repository root:
 
     python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 30] [--jump-weight 100]
-        [--acceptance SCENARIOS] [--out out/bench_robust] [--json FILE]
+        [--acceptance SCENARIOS] [--aggregate mean|worst] [--t-max-margin 0.005] [--out DIR] [--json FILE]
 """
 
 import argparse
@@ -51,13 +51,14 @@ def scenario_set(scene, count):
     return sets[count]
 
 
-def solve(scene, scenarios, intervals, jump_weight, t_max_margin=0.0):
+def solve(scene, scenarios, intervals, jump_weight, t_max_margin=0.0, aggregate="mean"):
     start = time.perf_counter()
     problem = RobustOCP(scene, scenarios, intervals=intervals, jump="penalty")
     problem.fastest_lockups()
     build = time.perf_counter() - start
     start = time.perf_counter()
-    result = problem.solve(weights={"jump": jump_weight}, t_max=(1 - t_max_margin) * problem.ocp.default_t_max())
+    result = problem.solve(weights={"jump": jump_weight}, t_max=(1 - t_max_margin) * problem.ocp.default_t_max(),
+                           aggregate=aggregate)
     total = time.perf_counter() - start
     return problem, result, build, total
 
@@ -74,9 +75,10 @@ def label(overrides, centre):
                     for name in centre)
 
 
-def acceptance(scene, intervals, jump_weight, out, count=9, t_max_margin=0.0):
+def acceptance(scene, intervals, jump_weight, out, count=9, t_max_margin=0.0, aggregate="mean"):
     corners, centre = box_points(scene)
-    problem, robust, build, total = solve(scene, scenario_set(scene, count), intervals, jump_weight, t_max_margin)
+    problem, robust, build, total = solve(scene, scenario_set(scene, count), intervals, jump_weight, t_max_margin,
+                                          aggregate)
     t_max = problem.ocp.default_t_max()       # the limit the replays are judged by
     print(f"robust ({count} scenarios, {intervals} intervals): build {build:.1f} s, solve {total:.1f} s, "
           f"{robust.stats['iterations']} iterations", file=sys.stderr)
@@ -94,7 +96,7 @@ def acceptance(scene, intervals, jump_weight, out, count=9, t_max_margin=0.0):
                "robust_optimum": replay_numbers(simulate_command(s, robust.command_times, robust.command, t_end,
                                                                  model=model, control="linear"), t_max)}
         rows.append(row)
-    summary = {"t_max_s": t_max, "t_max_solved_s": robust.t_max, "intervals": intervals, "jump_weight": jump_weight, "scenarios": count,
+    summary = {"t_max_s": t_max, "t_max_solved_s": robust.t_max, "aggregate": aggregate, "intervals": intervals, "jump_weight": jump_weight, "scenarios": count,
                "robust_build_s": build, "corners": rows,
                "robust_solve_s": total, "robust_iterations": robust.stats["iterations"],
                "robust_collocation_jumps_Nm": [s.terms["lockup_torque_jump_Nm"] for s in robust.scenarios],
@@ -153,6 +155,7 @@ def main():
                         help="solve with this scenario set (1, 3, 5, 9) and replay at the 9 box points")
     parser.add_argument("--t-max-margin", type=float, default=0.0,
                         help="solve the robust problem with t_max (1 - margin) (replays judged by t_max)")
+    parser.add_argument("--aggregate", choices=("mean", "worst"), default="mean")
     parser.add_argument("--out", default="out/bench_robust")
     parser.add_argument("--json", help="also write the results to this JSON file")
     args = parser.parse_args()
@@ -166,7 +169,8 @@ def main():
         report["timing"].append(row)
         print(f"{count:9d} {build:10.1f} {total:10.1f} {row['iterations']:10d} {row['solves']:9d}", flush=True)
     if args.acceptance is not None:
-        acc = acceptance(scene, args.intervals, args.jump_weight, Path(args.out), args.acceptance, args.t_max_margin)
+        acc = acceptance(scene, args.intervals, args.jump_weight, Path(args.out), args.acceptance, args.t_max_margin,
+                         args.aggregate)
         report["acceptance"] = acc
         print(f"t_max = {acc['t_max_s']:.4f} s")
         print(f"{'corner':>26s} | {'baseline':>18s} | {'nominal optimum':>18s} | {'robust optimum':>18s}")

@@ -243,7 +243,8 @@ def _cmd_optimize(args):
     sweep = parse_time_list(args.sweep_t_max, "--sweep-t-max") if args.sweep_t_max is not None else None
     run_optimize(scene, out_dir=args.out, t_max=args.t_max, weights=weights,
                  intervals=args.intervals, degree=args.degree, sweep_t_max=sweep,
-                 max_temperature_C=args.max_temperature, max_specific_power_W_mm2=args.max_specific_power)
+                 max_temperature_C=args.max_temperature, max_specific_power_W_mm2=args.max_specific_power,
+                 clamp_margin=args.clamp_margin)
     return 0
 
 
@@ -360,6 +361,9 @@ def build_parser():
                    help="largest interface temperature [degC] while slipping (scene needs a [thermal] part)")
     p.add_argument("--max-specific-power", type=positive_float, default=None, metavar="W_MM2",
                    help="largest interface heat power per friction area [W/mm^2] while slipping")
+    p.add_argument("--clamp-margin", type=positive_float, default=1.3, metavar="RATIO",
+                   help="after lock-up, ramp to the clamp pressure whose static torque capacity is RATIO x "
+                        "the locked torque (>= 1, default: 1.3)")
     p.set_defaults(run=_cmd_optimize)
     p = sub.add_parser("bench", help="error against run time, stiffness and scaling (work-precision report)")
     p.add_argument("--quick", action="store_true", help="fewer tolerances, repeats and sizes, no native code (a few minutes)")

@@ -61,6 +61,7 @@ def test_optimize_default_scene_writes_the_issue_keys(tmp_path):
         (["optimize", "--t-max", "0.01"], "t_max"),
         (["optimize", "--weights", "jerk"], "--weights"),
         (["optimize", "--sweep-t-max", "a:b"], "--sweep-t-max"),
+        (["optimize", "--clamp-margin", "0.5"], "margin"),
         (["simulate", "zhang2021", "--set", "oil.viscosty=0.1"], "oil.viscosty"),
         (["simulate", "chen2021"], "engagement"),
         (["control", "zhang2021"], "hvd"),

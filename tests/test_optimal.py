@@ -183,5 +183,11 @@ def test_run_optimize_writes_the_files(tmp_path):
     assert data["solver"]["wall_time_s"] > 0
     assert [p["t_max_s"] for p in data["sweep"]] == [0.2, 0.25]
     header = (tmp_path / "pressure_profile.csv").read_text().splitlines()[0]
-    assert header == "time_s,pressure_command_Pa,pressure_Pa"
+    assert header == "time_s,pressure_command_Pa,pressure_Pa,phase,to_next"
+    rows = (tmp_path / "pressure_profile.csv").read_text().splitlines()[1:]
+    assert rows[-1].endswith("clamp_hold,hold") and rows[0].endswith("engagement,linear")
+    clamp = data["clamp"]
+    assert clamp["lock_held"] and clamp["margin"] == 1.3
+    assert float(rows[-1].split(",")[1]) == pytest.approx(clamp["clamp_pressure_Pa"])
+    assert clamp["capacity_margin_at_end"] == pytest.approx(1.3, rel=5e-3)
     assert summary["optimal"] == data["optimal"]

@@ -22,6 +22,10 @@ class OptimizationResult:
         The optimal command re-simulated with IDAS.
     baselines : dict
         ``{label: (EngagementResult, numbers)}`` of the step, ramp and lag profiles.
+    curve : clutchocp.optimal.clamp.ClampedCommand
+        The whole usable command: the optimum, then the ramp to the clamp pressure and its hold.
+    clamp_run : clutchocp.engagement.run.EngagementResult
+        IDAS replay of the whole curve (through lock-up and the clamp ramp).
     fill : dict or None
         On a scene with a fill phase: the minimum-time optimum against the tuned "fill pulse, hold,
         ramp" baseline (``summary``, ``optimal_run``, ``baseline_run``); None otherwise.
@@ -34,6 +38,8 @@ class OptimizationResult:
     replay: object
     baselines: dict = field(default_factory=dict)
     fill: dict = None
+    curve: object = None
+    clamp_run: object = None
 
     def __repr__(self):
         s = self.summary
@@ -49,9 +55,10 @@ class OptimizationResult:
         return bool(self.optimum.success and self.summary["verification"]["passed"])
 
     def table(self):
-        """The pressure profile: ``time_s``, ``pressure_command_Pa``, ``pressure_Pa`` (pressure_profile.csv)."""
+        """The whole pressure curve as in pressure_profile.csv: ``time_s``, ``pressure_command_Pa``,
+        ``pressure_Pa``, ``phase``, ``to_next``."""
         from .report import profile_columns
-        return Table(profile_columns(self.ocp, self.optimum))
+        return Table(profile_columns(self.optimum, self.curve, self.clamp_run))
 
     def plot(self, path=None):
         """The pressure figure (command, IDAS replay, baseline); saved as PNG if ``path`` is given.
@@ -62,7 +69,7 @@ class OptimizationResult:
         """
         from ..output import save_figure
         from .report import pressure_figure
-        fig = pressure_figure(self.scene, self.optimum, self.replay, self.ocp.baseline, self.summary)
+        fig = pressure_figure(self.scene, self.optimum, self.replay, self.ocp.baseline, self.summary, self.curve)
         if path is not None:
             save_figure(fig, path)
         return fig

@@ -208,6 +208,11 @@ class EngagementOCP:
         Largest interface heat power per friction area [W/mm^2] over the slip phase.
     """
 
+    # Scene values that are a parameter vector of the NLP functions (appended to the weights; the
+    # outputs and jump functions take it as a third input); empty here, set by
+    # clutchocp.optimal.robust.ParametricOCP for the scenarios of a robust problem.
+    theta = ca.SX(0, 1)
+
     def __init__(self, scene, *, intervals=100, degree=3, scheme="radau", control="linear", rate_limit=None,
                  h_min=None, jump="constraint", lock_margin=0.005, smooth=True, polish=True,
                  transcription=None, baseline=None, fill_intervals=30, jerk_max=None, quasi_static_plates=None,
@@ -415,9 +420,13 @@ class EngagementOCP:
         c = ca.vertcat(c, *[subs(physical[name]) / limit for name, limit in self.heat_limits])
         weights = ca.SX.sym("weights", len(OBJECTIVE_TERMS))
         w = dict(zip(OBJECTIVE_TERMS, ca.vertsplit(weights)))
+        # A robust problem's scenario values (self.theta, empty here) follow the weights in the parameter
+        # of the dynamics, objective and end functions, and are a third input of the outputs and jump.
+        theta = [self.theta] if self.theta.numel() else []
+        params = ca.vertcat(weights, self.theta)
         out = {"output_names": list(physical), "subs": subs,
-               "outputs_fn": ca.Function("outputs", [xs, us], [subs(ca.vertcat(*physical.values()))]),
-               "dynamics_fn": ca.Function("dynamics", [xs, us, weights], [xdot, q, c])}
+               "outputs_fn": ca.Function("outputs", [xs, us, *theta], [subs(ca.vertcat(*physical.values()))]),
+               "dynamics_fn": ca.Function("dynamics", [xs, us, params], [xdot, q, c])}
         Q = ca.SX.sym("Q", 2)
         T = ca.SX.sym("T")
         locked, slipping = subs(physical["locked_torque_Nm"]), subs(physical["total_torque_Nm"])
@@ -427,27 +436,27 @@ class EngagementOCP:
             kiss = subs(physical["piston_speed_m_s"]) / sc.speed_m_s
             J = (w["jerk"] * Q[0] + w["smooth"] * Q[1] + (w["time"] + w["fill_time"]) * T
                  + w["kiss_speed"] * kiss**2)
-            out["objective_fn"] = ca.Function("objective", [xs, us, Q, T, weights], [J])
+            out["objective_fn"] = ca.Function("objective", [xs, us, Q, T, params], [J])
             i_x0 = self._names.index("x0")
             g_end = [xs[i_x0] - self.model.travel / self.nominal[i_x0]]
             if self.jerk_max is not None:     # the jerk just after the kiss (slip mode, after the reset)
                 g_end.append(self.kiss_jerk_fn(xs, us) / self.jerk_max)
-            out["end_fn"] = ca.Function("end", [xs, us, T, weights], [ca.vertcat(*g_end)])
-            out["jump_fn"] = ca.Function("jump", [xs, us], [jump * sc.torque_Nm])
+            out["end_fn"] = ca.Function("end", [xs, us, T, params], [ca.vertcat(*g_end)])
+            out["jump_fn"] = ca.Function("jump", [xs, us, *theta], [jump * sc.torque_Nm])
             return out
         if self.holds_torque:
             jump_condition = (locked * (1 + self.lock_margin) - slipping) / sc.torque_Nm
         else:   # a lock that carries nothing: a small slipping torque left, so the slip still falls at t_f
             jump_condition = (self.lock_margin * sc.torque_Nm - slipping) / sc.torque_Nm
         J = w["jerk"] * Q[0] + w["energy"] * xs[n] + w["time"] * T + w["jump"] * jump**2 + w["smooth"] * Q[1]
-        out["objective_fn"] = ca.Function("objective", [xs, us, Q, T, weights], [J])
+        out["objective_fn"] = ca.Function("objective", [xs, us, Q, T, params], [J])
         # The lock must hold: the static capacity (about the slipping torque at lock-up) may not be
         # falling at t_f. Without this row the optimum lets the pressure fall through lock-up.
         capacity_rate = subs(physical["capacity_rate_Nm_s"]) * t_ref / sc.torque_Nm
         g_end = [slip] + ([jump_condition] if self.jump_mode == "constraint" else []) \
             + ([capacity_rate] if self.holds_torque else []) + [xs[n]]
-        out["end_fn"] = ca.Function("end", [xs, us, T, weights], [ca.vertcat(*g_end)])
-        out["jump_fn"] = ca.Function("jump", [xs, us], [jump * sc.torque_Nm])
+        out["end_fn"] = ca.Function("end", [xs, us, T, params], [ca.vertcat(*g_end)])
+        out["jump_fn"] = ca.Function("jump", [xs, us, *theta], [jump * sc.torque_Nm])
         return out
 
     def _full_state(self, xs):

@@ -13,9 +13,10 @@ from .baselines import baseline_label, simulate_baselines, tune_fill_pulse
 from .outcome import OptimizationResult
 from .bound import jerk_lower_bound
 from .heat import heat_check
+from .clamp import DEFAULT_MARGIN, check_margin, extend_to_clamp
 from .problem import EngagementOCP
-from .replay import CommandModel
-from .verify import HOLD_DELAY, holding_pressure, run_numbers, verify
+from .replay import CommandModel, simulate_command
+from .verify import run_numbers, verify
 
 KEYS = ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral", "dissipated_energy_J", "peak_jerk_rad_s3",
         "peak_torque_Nm")
@@ -24,9 +25,13 @@ COMPARE_KEYS = KEYS + ("locked_torque_Nm", "kiss_time_s", "kiss_speed_m_s", "kis
 FAST_WEIGHTS = {"jerk": 0.0, "time": 1.0, "smooth": 0.01}
 
 
+CLAMP_SETTLE_S = 0.3       # the whole-curve replay runs this long after the clamp ramp ends
+
+
 @writes_folder
 def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, intervals=100, degree=3,
-                 sweep_t_max=None, progress=True, max_temperature_C=None, max_specific_power_W_mm2=None):
+                 sweep_t_max=None, progress=True, max_temperature_C=None, max_specific_power_W_mm2=None,
+                 clamp_margin=DEFAULT_MARGIN):
     """Optimal engagement pressure of a scene: solve, verify with IDAS, compare, write files.
 
     Parameters
@@ -49,6 +54,10 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         Print progress lines (stages, sweep points) and the summary.
     max_temperature_C, max_specific_power_W_mm2 : float, optional
         Heat limits of the slip phase (see :mod:`clutchocp.optimal.heat`); adds ``heat`` to the summary.
+    clamp_margin : float
+        Static torque capacity at the clamp pressure over the locked torque (>= 1): after lock-up
+        the command ramps at the rate limit to that clamp pressure and holds it
+        (:mod:`clutchocp.optimal.clamp`); pressure_profile.csv holds the whole curve.
 
     Returns
     -------
@@ -63,11 +72,11 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     say = print if progress else (lambda *a, **k: None)
     result = optimize_scene(scene, t_max=t_max, weights=weights, intervals=intervals, degree=degree,
                             sweep_t_max=sweep_t_max, progress=progress, max_temperature_C=max_temperature_C,
-                            max_specific_power_W_mm2=max_specific_power_W_mm2)
+                            max_specific_power_W_mm2=max_specific_power_W_mm2, clamp_margin=clamp_margin)
     summary, scene, ocp, opt, replay = result.summary, result.scene, result.ocp, result.optimum, result.replay
     out = Path(out_dir)
-    files = [_write_profile(out, ocp, opt), write_summary(out / "summary.json", summary)]
-    files += plot_optimum(out, scene, opt, replay, ocp.baseline, result.baselines, summary)
+    files = [_write_profile(out, result), write_summary(out / "summary.json", summary)]
+    files += plot_optimum(out, scene, opt, replay, ocp.baseline, result.baselines, summary, result.curve)
     files.append(plot_heat(replay, out / "heat.png", max_temperature_C=max_temperature_C,
                            max_specific_power_W_mm2=max_specific_power_W_mm2, what="the IDAS replay of the optimum"))
     if ocp.model.has_piston:
@@ -83,7 +92,7 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
 
 
 def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degree=3, sweep_t_max=None,
-                   progress=False, max_temperature_C=None, max_specific_power_W_mm2=None):
+                   progress=False, max_temperature_C=None, max_specific_power_W_mm2=None, clamp_margin=DEFAULT_MARGIN):
     """Solve, verify with IDAS and compare with the baselines, without writing files.
 
     Parameters are those of :func:`run_optimize` (``scene`` may also be a name or a path).
@@ -95,6 +104,7 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
         the baseline runs; ``table()`` and ``plot()`` for a look.
     """
     say = print if progress else (lambda *a, **k: None)
+    clamp_margin = check_margin(clamp_margin)          # a bad margin fails before the solve
     if scene is None:
         scene = default_scene()
     elif isinstance(scene, (str, Path)):
@@ -112,6 +122,10 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
     say(f"  IDAS re-simulation: lock-up {_fmt(check['idas']['engagement_time_s'], 's')}, "
         f"jump {_fmt(check['torque_jump_Nm'], 'N m')}")
     fill = _fill_comparison(ocp, opt, check, command_model, intervals, degree, say) if len(opt.phases) > 1 else None
+    curve, whole = _clamp_curve(scene, ocp, opt, command_model, clamp_margin)
+    say(f"  after lock-up: ramp to the clamp pressure {curve.clamp_pressure_Pa / 1e6:.4g} MPa by "
+        f"{curve.ramp_end_s:.4g} s (capacity {curve.margin:g} x the locked torque); lock held in the IDAS replay: "
+        f"{whole['lock_held']}")
     baselines = simulate_baselines(scene)
     w_rel0, rate0 = ocp.initial_slip()
     bound = jerk_lower_bound(w_rel0, rate0, opt.t_f)
@@ -140,6 +154,7 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
         "weights": opt.weights,
         "phases": [{k: ph[k] for k in ("name", "mode", "t_start_s", "t_end_s", "intervals")} for ph in opt.phases],
         "lockup_definition": _lockup_definition(ocp),
+        "clamp": {k: v for k, v in whole.items() if k != "run"},
         "solver": {"status": opt.stats["status"], "iterations": opt.stats["iterations"],
                    "wall_time_s": opt.stats["wall_time_s"], "build_time_s": build_time,
                    "intervals": intervals, "degree": degree, "scheme": ocp.transcription.scheme,
@@ -154,7 +169,8 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
         summary["sweep"] = sweep
     if fill is not None:
         summary["fill_comparison"] = fill["summary"]
-    return OptimizationResult(scene, summary, ocp, opt, replay, baselines, fill=fill)
+    return OptimizationResult(scene, summary, ocp, opt, replay, baselines, fill=fill, curve=curve,
+                              clamp_run=whole["run"])
 
 
 def _lockup_definition(ocp):
@@ -208,6 +224,39 @@ def _fill_comparison(ocp, opt, check, command_model, intervals, degree, say):
     return {"summary": summary, "optimal_run": fast_run, "baseline_run": tuned["run"], "baseline": tuned}
 
 
+def _public(summary):
+    """The summary without the replay run object (kept for the CSV and the figures)."""
+    out = dict(summary)
+    out["clamp"] = {k: v for k, v in summary["clamp"].items() if k != "run"}
+    return out
+
+
+def _clamp_curve(scene, ocp, opt, command_model, margin):
+    """The optimal command continued by the ramp to the clamp pressure, and its IDAS replay.
+
+    Returns
+    -------
+    (ClampedCommand, dict)
+        The curve and the summary entry ``clamp`` (with the replay run under ``run``).
+    """
+    rate = ocp.rate_limit if np.isfinite(ocp.rate_limit) else None
+    curve = extend_to_clamp(scene, opt.command_times, opt.command, opt.t_f, margin=margin, rate_limit=rate)
+    t_end = curve.ramp_end_s + CLAMP_SETTLE_S
+    run = simulate_command(scene, curve.times, curve.pressures, t_end, model=command_model, control="linear",
+                           points=601)
+    lock = [e.t for e in run.result.events if e.name == "lockup"]
+    unlock = [e.t for e in run.result.events if e.name == "unlock"]
+    torque = run.result["total_torque_Nm"][-1]
+    entry = {"margin": curve.margin, "clamp_pressure_Pa": curve.clamp_pressure_Pa,
+             "locked_torque_Nm": curve.locked_torque_Nm, "ramp_start_s": curve.ramp_start_s,
+             "ramp_end_s": curve.ramp_end_s, "rate_limit_Pa_s": curve.rate_limit_Pa_s,
+             "replay_end_s": t_end, "lock_time_s": lock[0] if lock else None,
+             "lock_held": bool(lock) and not unlock,
+             "capacity_margin_at_end": float(run.result["static_capacity_Nm"][-1] / torque) if lock else None,
+             "run": run}
+    return curve, entry
+
+
 def _fmt(value, unit, fmt="{:.4g}"):
     return "none" if value is None else f"{fmt.format(value)} {unit}"
 
@@ -238,23 +287,30 @@ def _sweep(ocp, opt, values, weights, say):
     return [results[v] for v in values]
 
 
-def _write_profile(out, ocp, opt):
-    """pressure_profile.csv: time, command and pressure [s, Pa, Pa].
+def _write_profile(out, result):
+    """pressure_profile.csv: the whole usable command, engagement and clamp [s, Pa, Pa].
 
-    Piecewise-linear command: its nodes (linear in between). Piecewise-constant command: the value
-    from each time on. After lock-up (the last time) the command is the holding pressure of the
-    verification (summary: verification.holding_pressure_Pa; the last row of a constant command).
+    Rows are the nodes of the piecewise-linear command: ``to_next`` says how the command goes on
+    to the next row ("linear") or after the last one ("hold": constant). ``phase`` names the
+    segment a row starts: "engagement" before lock-up, "clamp_ramp" from the lock-up row,
+    "clamp_hold" on the last row. ``pressure_Pa`` is the
+    pressure the collocation predicts up to lock-up and the IDAS replay of the whole curve after it.
     """
-    return write_csv(out / "pressure_profile.csv", profile_columns(ocp, opt))
+    return write_csv(out / "pressure_profile.csv", profile_columns(result.optimum, result.curve, result.clamp_run))
 
 
-def profile_columns(ocp, opt):
+def profile_columns(opt, curve, run):
     """The columns of pressure_profile.csv (see :func:`_write_profile`): {name with unit: array}."""
-    times = np.append(opt.command_times, opt.t_f * (1 + HOLD_DELAY)) if opt.control == "constant" \
-        else opt.command_times.copy()
-    command = np.append(opt.command, holding_pressure(ocp, opt)) if opt.control == "constant" else opt.command
-    pressure = np.interp(times, opt.t, opt.outputs["pressure_Pa"])
-    return {"time_s": times, "pressure_command_Pa": command, "pressure_Pa": pressure}
+    times, command = curve.times, curve.pressures
+    engaged = times <= opt.t_f
+    pressure = np.where(engaged, np.interp(times, opt.t, opt.outputs["pressure_Pa"]),
+                        np.interp(times, run.result.t, run.result["pressure_Pa"]))
+    phase = np.where(times < opt.t_f, "engagement", "clamp_ramp").astype(object)   # the segment a row starts
+    if times[-1] > opt.t_f:
+        phase[-1] = "clamp_hold"
+    to_next = ["linear"] * (times.size - 1) + ["hold"]
+    return {"time_s": times, "pressure_command_Pa": command, "pressure_Pa": pressure,
+            "phase": list(phase), "to_next": to_next}
 
 
 def _slip(run):
@@ -263,12 +319,12 @@ def _slip(run):
     return res.t, (res.t <= t_lock) if t_lock is not None else np.ones(res.t.size, bool)
 
 
-def plot_optimum(out, scene, opt, replay, baseline, baselines, summary):
+def plot_optimum(out, scene, opt, replay, baseline, baselines, summary, curve=None):
     """Pressure, torque, speeds and jerk of the optimum (IDAS replay) against the baseline; baselines bar chart."""
     files = []
     name = scene.name
     runs = (("optimal (IDAS replay)", replay, "C0"), (f"baseline ({summary['baseline']['profile']})", baseline, "C3"))
-    files.append(save_figure(pressure_figure(scene, opt, replay, baseline, summary), out / "pressure.png"))
+    files.append(save_figure(pressure_figure(scene, opt, replay, baseline, summary, curve), out / "pressure.png"))
 
     for key, ylabel, fname, title in (("total_torque_Nm", "clutch torque [N m]", "torque.png", "clutch torque"),
                                       ("output_jerk_rad_s3", "output jerk [rad/s^3]", "jerk.png", "output jerk")):
@@ -298,8 +354,9 @@ def plot_optimum(out, scene, opt, replay, baseline, baselines, summary):
     return files
 
 
-def pressure_figure(scene, opt, replay, baseline, summary):
-    """The optimal command, its IDAS replay, the collocation points and the baseline's pressure."""
+def pressure_figure(scene, opt, replay, baseline, summary, curve=None):
+    """The optimal command (and its continuation after lock-up, ``curve``), its IDAS replay, the
+    collocation points and the baseline's pressure."""
     runs = (("optimal (IDAS replay)", replay, "C0"), (f"baseline ({summary['baseline']['profile']})", baseline, "C3"))
     fig, (ax,) = new_figure()
     if opt.control == "constant":
@@ -307,6 +364,12 @@ def pressure_figure(scene, opt, replay, baseline, summary):
                 where="post", color="C0", lw=0.8, alpha=0.6, label="optimal command")
     else:
         ax.plot(opt.command_times, opt.command / 1e6, color="C0", lw=0.8, alpha=0.6, label="optimal command")
+    if curve is not None:       # the command after lock-up: ramp to the clamp pressure, then hold it
+        after = curve.times >= opt.t_f
+        t_hold = max(curve.times[-1], max(run.result.t[-1] for _, run, _ in runs))
+        ax.plot(np.append(curve.times[after], t_hold), np.append(curve.pressures[after], curve.pressures[-1]) / 1e6,
+                color="C2", lw=1.2, ls="--",
+                label=f"command after lock-up: ramp to clamp ({curve.margin:g} x locked torque)")
     for label, run, color in runs:
         ax.plot(run.result.t, run.result["pressure_Pa"] / 1e6, color=color, label=label)
     ax.plot(opt.t, opt.outputs["pressure_Pa"] / 1e6, ".", color="C0", ms=2, label="collocation")

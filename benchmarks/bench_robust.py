@@ -1,0 +1,193 @@
+"""Robust feedforward: solve time against the number of scenarios, and the corner replay.
+
+The uncertainty box the default scene declares ([uncertainty]: friction.mu +-10 %, oil.viscosity
++-30 %, load.torque +-20 %, uniform), as ``scene.uncertainty`` gives it. Scenario sets: 1 = the
+centre; 3 = centre and the two extreme corners (all low, all high); 5 = centre and four corners
+that differ pairwise in two fields; 9 = the 8 corners and the centre.
+
+Timing (``--scenarios``): for each set, the build (scenario scenes, their baseline and fastest
+IDAS runs, the parametric model) and the solve (coarse presolve, re-solves that move lock-ups
+between command intervals, exact polish) [s], with IPOPT iterations.
+
+Acceptance (``--acceptance 9``): the robust command of a scenario set, the nominal optimum and the scene's
+own baseline profile, each replayed with IDAS at the 8 corners and the centre: lock-up time and
+torque jump at lock-up per corner; figures corner_jumps.png and commands.png in ``--out``.
+
+Run from the repository root:
+
+    python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 30] [--jump-weight 100]
+        [--acceptance SCENARIOS] [--aggregate mean|worst] [--t-max-margin 0.005] [--out DIR] [--json FILE]
+"""
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from clutchocp.engagement.run import simulate_engagement
+from clutchocp.optimal import EngagementOCP
+from clutchocp.optimal.robust import RobustOCP
+from clutchocp.optimal.replay import CommandModel, simulate_command
+from clutchocp.output import new_figure, save_figure
+from clutchocp.scene import default_scene
+
+def box_points(scene):
+    """(corners, centre) of the scene's uncertainty box as override dicts [SI]."""
+    box = scene.uncertainty
+    if not box.names:
+        sys.exit(f"scene '{scene.name}' declares no [uncertainty]")
+    return box.corners(), box.centre()
+
+
+def scenario_set(scene, count):
+    corners, centre = box_points(scene)
+    sets = {1: [centre], 3: [corners[0], centre, corners[-1]],
+            5: [centre, corners[0], corners[3], corners[5], corners[6]], 9: corners + [centre]}
+    if count not in sets:
+        sys.exit(f"--scenarios: choose from {sorted(sets)}")
+    return sets[count]
+
+
+def solve(scene, scenarios, intervals, jump_weight, t_max_margin=0.0, aggregate="mean"):
+    start = time.perf_counter()
+    problem = RobustOCP(scene, scenarios, intervals=intervals, jump="penalty")
+    problem.fastest_lockups()
+    build = time.perf_counter() - start
+    start = time.perf_counter()
+    result = problem.solve(weights={"jump": jump_weight}, t_max=(1 - t_max_margin) * problem.ocp.default_t_max(),
+                           aggregate=aggregate)
+    total = time.perf_counter() - start
+    return problem, result, build, total
+
+
+def replay_numbers(run, t_max):
+    t_lock = run.summary["engagement_time_s"]
+    return {"lock_time_s": t_lock, "jump_Nm": run.summary["lockup_torque_jump_Nm"],
+            "locks_within_t_max": t_lock is not None and t_lock <= t_max}
+
+
+def label(overrides, centre):
+    return " ".join(f"{name.split('.')[-1]}{'+' if overrides[name] > centre[name] else '-'}"
+                    if not np.isclose(overrides[name], centre[name]) else f"{name.split('.')[-1]}0"
+                    for name in centre)
+
+
+def acceptance(scene, intervals, jump_weight, out, count=9, t_max_margin=0.0, aggregate="mean"):
+    corners, centre = box_points(scene)
+    problem, robust, build, total = solve(scene, scenario_set(scene, count), intervals, jump_weight, t_max_margin,
+                                          aggregate)
+    t_max = problem.ocp.default_t_max()       # the limit the replays are judged by
+    print(f"robust ({count} scenarios, {intervals} intervals): build {build:.1f} s, solve {total:.1f} s, "
+          f"{robust.stats['iterations']} iterations", file=sys.stderr)
+    nominal = EngagementOCP(scene, intervals=intervals, baseline=problem.ocp.baseline).solve(t_max=t_max)
+    # (the nominal optimum uses the whole t_max: it is the issue's "nominal optimum")
+    rows = []
+    for overrides in corners + [centre]:
+        s = scene.with_overrides(overrides)
+        model = CommandModel(s, "linear")
+        t_end = 3.0 * t_max
+        row = {"corner": label(overrides, centre), "overrides": overrides,
+               "baseline": replay_numbers(simulate_engagement(s), t_max),
+               "nominal_optimum": replay_numbers(simulate_command(s, nominal.command_times, nominal.command, t_end,
+                                                                  model=model, control="linear"), t_max),
+               "robust_optimum": replay_numbers(simulate_command(s, robust.command_times, robust.command, t_end,
+                                                                 model=model, control="linear"), t_max)}
+        rows.append(row)
+    summary = {"t_max_s": t_max, "t_max_solved_s": robust.t_max, "aggregate": aggregate, "intervals": intervals, "jump_weight": jump_weight, "scenarios": count,
+               "robust_build_s": build, "corners": rows,
+               "robust_solve_s": total, "robust_iterations": robust.stats["iterations"],
+               "robust_collocation_jumps_Nm": [s.terms["lockup_torque_jump_Nm"] for s in robust.scenarios],
+               "robust_collocation_lock_times_s": robust.lock_times.tolist()}
+    for key in ("baseline", "nominal_optimum", "robust_optimum"):
+        jumps = [abs(r[key]["jump_Nm"]) for r in rows if r[key]["jump_Nm"] is not None]
+        summary[key] = {"all_lock_within_t_max": all(r[key]["locks_within_t_max"] for r in rows),
+                        "worst_abs_jump_Nm": max(jumps) if jumps else None,
+                        "locked": sum(r[key]["lock_time_s"] is not None for r in rows)}
+    plot(out, scene, rows, robust, nominal, problem, t_max, count)
+    return summary
+
+
+def plot(out, scene, rows, robust, nominal, problem, t_max, count):
+    out.mkdir(parents=True, exist_ok=True)
+    names = [r["corner"] for r in rows]
+    strategies = (("baseline", "baseline (scene profile)", "C3"), ("nominal_optimum", "nominal optimum", "C1"),
+                  ("robust_optimum", f"robust optimum (solved on {count} scenarios)", "C0"))
+    fig, (ax1, ax2) = new_figure(2, width=5.5)
+    x = np.arange(len(rows))
+    for k, (key, text, color) in enumerate(strategies):
+        jumps = [abs(r[key]["jump_Nm"]) if r[key]["jump_Nm"] is not None else np.nan for r in rows]
+        locks = [r[key]["lock_time_s"] if r[key]["lock_time_s"] is not None else np.nan for r in rows]
+        ax1.bar(x + (k - 1) * 0.27, jumps, width=0.27, color=color, label=text)
+        ax2.bar(x + (k - 1) * 0.27, locks, width=0.27, color=color, label=text)
+        for i, value in enumerate(locks):
+            if np.isnan(value):
+                ax2.text(i + (k - 1) * 0.27, 0.01, "no lock", rotation=90, fontsize=6, ha="center", va="bottom")
+    ax2.axhline(t_max, color="k", ls="--", lw=0.8, label=f"t_max = {t_max:.3f} s")
+    ax1.set(ylabel="|torque jump at lock-up| [N m]", title="IDAS replay at the 8 box corners and the centre")
+    ax2.set(ylabel="lock-up time [s]", title="lock-up time (same replays)")
+    for ax in (ax1, ax2):
+        ax.set_xticks(x, names, rotation=60, fontsize=7)
+        ax.legend(fontsize=7)
+    save_figure(fig, out / "corner_jumps.png")
+
+    fig, (ax,) = new_figure()
+    ax.plot(nominal.command_times, nominal.command / 1e6, color="C1", label="nominal optimum (command)")
+    ax.plot(robust.command_times, robust.command / 1e6, color="C0", label=f"robust optimum, {count} scenarios (command)")
+    base = problem.ocp.baseline.result
+    ax.plot(base.t, base["pressure_Pa"] / 1e6, color="C3", lw=0.8, label="baseline (pressure, centre)")
+    for t_lock in robust.lock_times:
+        ax.axvline(t_lock, color="C0", lw=0.5, ls=":")
+    ax.set(xlabel="time [s]", ylabel="pressure [MPa]", xlim=(0, 1.2 * t_max),
+           title=f"{scene.name}: commands (dotted: robust lock-up per scenario)")
+    ax.legend(fontsize=8)
+    save_figure(fig, out / "commands.png")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenarios", type=int, nargs="*", default=[1, 3, 5, 9])
+    parser.add_argument("--intervals", type=int, default=30)
+    parser.add_argument("--jump-weight", type=float, default=100.0)
+    parser.add_argument("--acceptance", type=int, default=None, metavar="SCENARIOS",
+                        help="solve with this scenario set (1, 3, 5, 9) and replay at the 9 box points")
+    parser.add_argument("--t-max-margin", type=float, default=0.0,
+                        help="solve the robust problem with t_max (1 - margin) (replays judged by t_max)")
+    parser.add_argument("--aggregate", choices=("mean", "worst"), default="mean")
+    parser.add_argument("--out", default="out/bench_robust")
+    parser.add_argument("--json", help="also write the results to this JSON file")
+    args = parser.parse_args()
+    scene = default_scene()
+    report = {"timing": []}
+    print(f"{'scenarios':>9s} {'build [s]':>10s} {'solve [s]':>10s} {'iterations':>10s} {'re-solves':>9s}")
+    for count in args.scenarios:
+        _, result, build, total = solve(scene, scenario_set(scene, count), args.intervals, args.jump_weight)
+        row = {"scenarios": count, "build_s": build, "solve_s": total, "iterations": result.stats["iterations"],
+               "solves": len(result.stats["stages"]), "objective": result.objective}
+        report["timing"].append(row)
+        print(f"{count:9d} {build:10.1f} {total:10.1f} {row['iterations']:10d} {row['solves']:9d}", flush=True)
+    if args.acceptance is not None:
+        acc = acceptance(scene, args.intervals, args.jump_weight, Path(args.out), args.acceptance, args.t_max_margin,
+                         args.aggregate)
+        report["acceptance"] = acc
+        print(f"t_max = {acc['t_max_s']:.4f} s")
+        print(f"{'corner':>26s} | {'baseline':>18s} | {'nominal optimum':>18s} | {'robust optimum':>18s}")
+        for r in acc["corners"]:
+            cells = []
+            for key in ("baseline", "nominal_optimum", "robust_optimum"):
+                n = r[key]
+                cells.append("never locks" if n["lock_time_s"] is None
+                             else f"{n['lock_time_s']:.4f} s {n['jump_Nm']:7.1f} N m")
+            print(f"{r['corner']:>26s} | " + " | ".join(f"{c:>18s}" for c in cells))
+        for key in ("baseline", "nominal_optimum", "robust_optimum"):
+            a = acc[key]
+            print(f"{key}: all lock within t_max: {a['all_lock_within_t_max']}, worst |jump| "
+                  f"{a['worst_abs_jump_Nm']} N m ({a['locked']}/9 lock)")
+    if args.json:
+        Path(args.json).write_text(json.dumps(report, indent=2, default=float))
+
+
+if __name__ == "__main__":
+    main()

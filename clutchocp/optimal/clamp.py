@@ -1,0 +1,199 @@
+"""The whole usable curve: after lock-up, a ramp to the clamp pressure that holds the lock, and hold.
+
+An engagement command ends at lock-up. A transmission controller then raises the pressure to a
+clamp level whose static torque capacity carries the locked torque with a margin, and holds it.
+The clamp pressure p_c solves
+
+    capacity(p_c) = margin x T_locked,
+
+capacity(p) being the static capacity sum_i mu_s F_c,i(h_i*) r_eff of the pack once its films have
+settled under the command p (every film rate zero: the face force is carried by the asperities and
+the static fluid load, see :meth:`clutchocp.engagement.films.FilmLaw.load_coefficients`), and
+T_locked the torque the locked driveline carries (:meth:`EngagementModel.locked_torque`).
+
+The default margin 1.3 covers a friction coefficient 10 % below the model's together with a locked
+torque 15 % above it (1.15 / 0.9 = 1.28): the spread of mu with temperature and wear and of the load
+that the robust feedforward is designed for. A larger margin costs only hydraulic power; a margin
+below 1 does not hold the lock.
+
+The command ramps from its value at lock-up to p_c at the rate limit (default: the pressure limit
+per 10 ms, as the optimisation's) and holds p_c; the curve is piecewise linear between its points.
+"""
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+from scipy import optimize
+
+from ..engagement.model import EngagementModel
+from ..errors import ModelError
+
+DEFAULT_MARGIN = 1.3
+LOCKED_MODE = "pressing_locked"
+
+
+def check_margin(margin):
+    """The margin as a float; a value that is not a number >= 1 raises ModelError."""
+    try:
+        value = float(margin)
+    except (TypeError, ValueError):
+        raise ModelError(f"clamp margin {margin!r}: must be a number >= 1 (static capacity / locked torque)") from None
+    if not (np.isfinite(value) and value >= 1.0):
+        raise ModelError(f"clamp margin {margin!r}: must be a number >= 1 (static capacity / locked torque)")
+    return value
+
+
+@dataclass
+class ClampedCommand:
+    """A command continued after lock-up: unpacks as ``times, pressures = ...``.
+
+    ``times`` [s] and ``pressures`` [Pa] are piecewise linear between the points and the last value
+    holds afterwards; the ramp to ``clamp_pressure_Pa`` runs from ``ramp_start_s`` (lock-up) to
+    ``ramp_end_s`` at ``rate_limit_Pa_s``; ``margin`` = settled static capacity / ``locked_torque_Nm``.
+    """
+
+    times: np.ndarray
+    pressures: np.ndarray
+    clamp_pressure_Pa: float
+    margin: float
+    locked_torque_Nm: float
+    ramp_start_s: float
+    ramp_end_s: float
+    rate_limit_Pa_s: float
+
+    def __iter__(self):
+        return iter((self.times, self.pressures))
+
+
+class ClampModel:
+    """Static capacity of a scene's pack against the settled command pressure, and the locked torque.
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+        An engagement scene with a massless pack (``pack.model = "massless"``).
+    """
+
+    def __init__(self, scene):
+        if scene.variant("pack") != "massless":
+            raise ModelError("clamp pressure: computed for a massless pack (pack.model = 'massless')")
+        if scene.has("piston"):
+            raise ModelError("clamp pressure: computed for a pack pressed directly by the command pressure "
+                             "(no [piston] part)")
+        u = ca.SX.sym("command")
+        self.model = model = EngagementModel(scene, smooth=False, pressure_command=u)
+        mode = model.modes[LOCKED_MODE]
+        self.films = [model.index[f"h_{i + 1}"] for i in range(model.n)]
+        x = model.x
+        if model.actuation.has_state:            # settled valve: its pressure is the command
+            x = ca.substitute(x, model.state("p_valve"), u)
+        rates = ca.vertcat(*[mode.ode[i] for i in self.films])
+        outputs = [mode.outputs["static_capacity_Nm"], mode.outputs["pressure_Pa"]]
+        self._fn = ca.Function("clamp", [model.x, u], [ca.substitute(ca.vertcat(rates, *outputs), model.x, x)])
+        self._locked = ca.Function("locked", [model.x], [model.locked_torque()])
+        self.x_lock = model.initial_state.copy()
+        w_lock = scene.value("driveline.output_speed")       # both sides at the output speed
+        for name in ("w_in", "w_out"):
+            if name in model.index:
+                self.x_lock[model.index[name]] = w_lock
+        self.p_max = scene.get("actuation.max_pressure")
+
+    def locked_torque(self, state=None):
+        """Torque the locked driveline carries [N m] (at ``state``, default: both sides at the output speed)."""
+        return float(self._locked(self.x_lock if state is None else state))
+
+    def settled_films(self, pressure):
+        """Film thicknesses [m] at which every film rate vanishes under the command ``pressure`` [Pa]."""
+        model = self.model
+        H0 = model.H0
+
+        def residual(h):
+            x = self.x_lock.copy()
+            x[self.films] = h
+            return np.array(self._fn(x, pressure)).ravel()[:len(self.films)] / (H0 / 0.01)
+
+        # All films carry the same face force: solve one film first (bisection on a bracket),
+        # then all of them together from there.
+        def first(h):
+            return residual(np.full(len(self.films), h))[0]
+
+        lo, hi = 1e-3 * model.sigma, H0
+        if first(lo) * first(hi) > 0:
+            raise ModelError(f"clamp pressure: no settled film thickness in [{lo:.3g}, {hi:.3g}] m at "
+                             f"{pressure / 1e6:.4g} MPa")
+        h0 = optimize.brentq(first, lo, hi, xtol=1e-15, rtol=1e-13)
+        sol = optimize.least_squares(residual, np.full(len(self.films), h0), x_scale=model.sigma, xtol=1e-15,
+                                     ftol=1e-15, gtol=1e-15)
+        return sol.x
+
+    def capacity(self, pressure):
+        """Static capacity [N m] of the settled pack under the command ``pressure`` [Pa]."""
+        x = self.x_lock.copy()
+        x[self.films] = self.settled_films(pressure)
+        return float(np.array(self._fn(x, pressure)).ravel()[len(self.films)])
+
+    def clamp_pressure(self, margin=DEFAULT_MARGIN, locked_torque=None):
+        """Command pressure [Pa] whose settled capacity is ``margin`` x the locked torque.
+
+        Raises
+        ------
+        ModelError
+            The pressure limit cannot give that capacity.
+        """
+        margin = check_margin(margin)
+        demand = abs(self.locked_torque() if locked_torque is None else float(locked_torque))
+        target = margin * demand
+        p_hi = self.p_max
+        if p_hi is None:
+            raise ModelError("actuation.max_pressure: the clamp pressure needs an upper pressure limit")
+        top = self.capacity(p_hi)
+        if top < target:
+            raise ModelError(f"clamp margin {margin:g}: the pressure limit {p_hi / 1e6:.4g} MPa gives a capacity of "
+                             f"{top:.4g} N m, {top / demand:.3g} x the locked torque {demand:.4g} N m; "
+                             "lower the margin or raise actuation.max_pressure")
+        return optimize.brentq(lambda p: self.capacity(p) - target, 1e-6 * p_hi, p_hi, xtol=1e-6, rtol=1e-12)
+
+
+def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MARGIN, rate_limit=None,
+                    locked_torque=None):
+    """The engagement command up to lock-up continued by a ramp to the clamp pressure.
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+    command_times, command : array
+        Nodes of the piecewise-linear engagement command [s], [Pa] (it may go on past t_lock).
+    t_lock : float
+        Lock-up time [s].
+    margin : float
+        Static torque capacity at the clamp pressure over the locked torque (>= 1).
+    rate_limit : float, optional
+        Ramp rate [Pa/s] (default: actuation.max_pressure per 10 ms, the optimisation's default).
+    locked_torque : float, optional
+        Torque the locked driveline carries [N m] (default: from the model, both sides at the output speed).
+
+    Returns
+    -------
+    ClampedCommand
+        Unpacks as ``times, pressures`` (piecewise linear between the points, the last value held
+        afterwards); also holds the clamp pressure, margin, locked torque and the ramp.
+    """
+    margin = check_margin(margin)
+    times, values = np.asarray(command_times, float), np.asarray(command, float)
+    if times.size != values.size or times.size < 1 or np.any(np.diff(times) <= 0):
+        raise ModelError("command: increasing times with one value each are needed")
+    if not (np.isfinite(t_lock) and times[0] < t_lock):
+        raise ModelError(f"t_lock = {t_lock!r}: must be a time after the command starts [s]")
+    clamp = ClampModel(scene)
+    p_c = clamp.clamp_pressure(margin, locked_torque)
+    rate = clamp.p_max / 0.01 if rate_limit is None else float(rate_limit)
+    if not (np.isfinite(rate) and rate > 0):
+        raise ModelError(f"rate_limit = {rate_limit!r}: must be a positive rate [Pa/s]")
+    keep = times < t_lock
+    p_lock = float(np.interp(t_lock, times, values))
+    t_end = t_lock + abs(p_c - p_lock) / rate
+    out_t = np.concatenate([times[keep], [t_lock], [t_end] if t_end > t_lock else []])
+    out_p = np.concatenate([values[keep], [p_lock], [p_c] if t_end > t_lock else []])
+    demand = abs(clamp.locked_torque() if locked_torque is None else float(locked_torque))
+    return ClampedCommand(out_t, out_p, p_c, margin, demand, float(t_lock), float(t_end), rate)

@@ -1,0 +1,751 @@
+"""Robust feedforward: one pressure command for several scenarios of a clutch (multi-scenario collocation).
+
+A scenario is a set of scene overrides (``{"friction.mu": 0.108, "oil.viscosity": 0.0884, ...}``,
+e.g. the corners of an uncertainty box). The robust problem chooses one pressure command u(t) that
+every scenario s meets with its own slip dynamics, its own free lock-up time T_s and its own end
+conditions (w_rel = 0, the jump condition or penalty, the lock holds), with films above h_min and
+T_s <= t_max, and minimises the mean (or the worst, by an epigraph variable z >= J_s) of the
+scenarios' objectives J_s (the terms of :mod:`clutchocp.optimal.problem`: jerk, jump, smooth, ...).
+
+How the scenarios share the command. A scenario that locks earlier sees only the start of the
+command, and its lock-up time is free, so the command is a function of absolute time: continuous
+and piecewise linear on a common grid of ``intervals`` equal steps h_c over [0, t_max] (it holds
+its last value afterwards; its pressure and rate bounds are linear constraints on the node values).
+Each scenario's collocation mesh is aligned with that grid: scenario s locks in command interval
+K_s, its mesh is the K_s full command intervals plus a last interval of free length tau_s in
+(0, h_c], and T_s = K_s h_c + tau_s. On a full interval the command is linear between two node
+values with fixed weights; on the last one it is V_K + (V_K+1 - V_K) tau_s tau_j / h_c, smooth in
+tau_s. So the NLP is smooth in every lock time. The two other ways were tried or weighed first: a
+mesh scaled by T_s on which the command is interpolated makes the NLP only continuous in T_s (its
+derivative jumps whenever a collocation point crosses a command node; measured on three corner
+scenarios, 20 intervals: IPOPT cycled for 300 iterations without converging, and the dense
+interpolation made every iteration slow), and one command copy per scenario needs the same
+interpolation to tie the copies together. The price of the aligned mesh is that the interval a
+scenario locks in is discrete: after a solve, a scenario whose tau_s sits on a bound of its
+interval with a multiplier pushing beyond it moves to the next interval and the problem is solved
+again from the last solution (a coarse presolve on 10 command steps finds the intervals first, so
+the fine grid needs few such re-solves). With one scenario that locks at t_max (the jerk optimum
+uses all the time it may) the mesh is the nominal problem's and so is the optimum (checked in
+tests/test_optimal_robust.py).
+
+Lock-up torque jump: each scenario may meet the nominal jump condition (``jump="constraint"``, the
+default of :class:`~clutchocp.optimal.problem.EngagementOCP`), but one command can rarely make
+every scenario lock tangentially (measured: infeasible on the centre and the two extreme corners
+of the default box), so the robust use is ``jump="penalty"`` with a ``jump`` weight: the jump of
+every scenario is an objective term.
+
+One dynamics function for all scenarios. The uncertain scene values are symbols of the model
+(:class:`ParametricScene`): :class:`ParametricOCP` builds the scaled dynamics, objective and end
+functions of the nominal problem with a parameter vector theta of those values, and the robust
+NLP evaluates the dynamics at every collocation point of every scenario by one CasADi ``map``
+(theta of the point's scenario as an input), so the cost of the NLP functions grows linearly with
+the number of scenarios. Scales, state groups and the initial state are those of the nominal scene.
+
+Stages: as for the nominal problem, first the smooth forms of the switching laws, then a warm-started
+polish on the exact forms. Derivatives: CasADi's automatic differentiation of the NLP graph (the
+structured assembly of :mod:`clutchocp.optimal.derivatives` assumes one scenario on a uniform mesh).
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from ..engagement.model import EngagementModel
+from ..errors import ModelError, SolverError
+from .collocation import _repeat_columns, _sparse
+from .derivatives import IPOPT_OPTIONS, WARM_OPTIONS
+from .guess import guess_from_run
+from .problem import OBJECTIVE_TERMS, SLIP_MODE, EngagementOCP, OptimalEngagement, check_weights
+from .replay import simulate_command
+
+AGGREGATES = ("mean", "worst")
+PRESOLVE_INTERVALS = 10
+
+
+class ParametricScene:
+    """A scene whose named values are CasADi symbols (everything else is the scene's).
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+    symbols : dict
+        ``{"part.key": casadi.SX}``.
+    """
+
+    def __init__(self, scene, symbols):
+        self._scene = scene
+        self._symbols = dict(symbols)
+        # The film law's static coefficient defaults to the (constant) friction coefficient at
+        # rest, which it evaluates as a number: give it the symbol instead.
+        if ("friction.mu" in self._symbols and scene.variant("friction") == "constant"
+                and scene.get("friction.static_coefficient") is None):
+            self._symbols["friction.static_coefficient"] = self._symbols["friction.mu"]
+
+    def value(self, name):
+        return self._symbols[name] if name in self._symbols else self._scene.value(name)
+
+    def get(self, name, default=None):
+        return self._symbols[name] if name in self._symbols else self._scene.get(name, default)
+
+    def __getattr__(self, name):
+        return getattr(self._scene, name)
+
+
+class ParametricOCP(EngagementOCP):
+    """The nominal engagement problem of a scene with some scene values as a parameter vector theta.
+
+    ``dynamics_fn``, ``objective_fn`` and ``end_fn`` take ``[weights; theta]`` as their parameter,
+    ``outputs_fn`` and ``jump_fn`` take theta as a third input. Scales, state groups, initial state
+    and the baseline are the nominal scene's.
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+    names : sequence of str
+        Scene fields (numeric, ``"part.key"``) that become theta.
+    **options
+        As for :class:`~clutchocp.optimal.problem.EngagementOCP`.
+    """
+
+    def __init__(self, scene, names, **options):
+        self.parameter_names = tuple(names)
+        self.theta = ca.SX.sym("theta", len(self.parameter_names))
+        self.theta_value = self.nominal_theta(scene)
+        super().__init__(scene, **options)
+
+    def nominal_theta(self, scene):
+        """theta of a scene (its SI values of the parameter names)."""
+        values = []
+        for name in self.parameter_names:
+            value = scene.value(name)
+            if not isinstance(value, (int, float, np.floating, np.integer)) or isinstance(value, bool):
+                raise ModelError(f"{name}: a robust scenario may vary numeric scene values only (got {value!r})")
+            values.append(float(value))
+        return np.array(values)
+
+    def _build_functions(self, mode_name=SLIP_MODE, role="slip"):
+        numeric = self.model
+        symbols = dict(zip(self.parameter_names, ca.vertsplit(self.theta)))
+        try:
+            self.model = EngagementModel(ParametricScene(self.scene, symbols), smooth=self.smooth,
+                                         pressure_command=self.u)
+            out = super()._build_functions(mode_name, role)
+        except (TypeError, RuntimeError, NotImplementedError) as exc:
+            raise ModelError(f"{', '.join(self.parameter_names)}: the engagement model cannot take these values as "
+                             f"symbols of one collocation problem ({type(exc).__name__}: {str(exc).splitlines()[0]})"
+                             ) from None
+        finally:
+            self.model = numeric
+        if self.theta.numel():
+            jump_theta = out["jump_fn"]
+            out["jump_fn"] = lambda x, u: jump_theta(x, u, self.theta_value)
+        return out
+
+    def _evaluate(self, xs, us):
+        if not self.theta.numel():
+            return super()._evaluate(xs, us)
+        n = len(us)
+        values = np.array(self.outputs_fn.map(n)(np.asarray(xs).T, np.asarray(us)[None, :],
+                                                 np.repeat(self.theta_value[:, None], n, axis=1)))
+        return {name: values[i] for i, name in enumerate(self.output_names)}
+
+    @property
+    def exact(self):
+        if self._exact is None:
+            self._exact = ParametricOCP(self.scene, self.parameter_names, smooth=False, polish=False,
+                                        baseline=self.baseline, transcription=self.transcription, **self.options)
+        return self._exact
+
+
+@dataclass
+class RobustEngagement:
+    """A solved (or failed) robust engagement.
+
+    ``command_times`` [s] and ``command`` [Pa] are the nodes of the shared piecewise-linear
+    command over [0, t_max] (it holds its last value afterwards); ``scenarios`` one
+    :class:`~clutchocp.optimal.problem.OptimalEngagement` per scenario (its ``t_f`` is the
+    scenario's lock-up time, its ``command`` the shared command at its own mesh nodes);
+    ``overrides`` the scenario override dicts; ``objectives`` each scenario's J_s.
+    """
+
+    command_times: np.ndarray
+    command: np.ndarray
+    scenarios: list
+    overrides: list
+    objectives: np.ndarray
+    objective: float
+    aggregate: str
+    weights: dict
+    scenario_weights: np.ndarray
+    t_max: float
+    stats: dict
+    w: np.ndarray = field(repr=False)
+    lam_x: np.ndarray = field(repr=False)
+    lam_g: np.ndarray = field(repr=False)
+
+    @property
+    def success(self):
+        return self.stats["success"]
+
+    @property
+    def lock_times(self):
+        """Lock-up time of each scenario [s]."""
+        return np.array([s.t_f for s in self.scenarios])
+
+
+def _check_scenarios(scene, scenarios):
+    """Parameter names and the scenario scenes (validated) of a list of override dicts."""
+    if not isinstance(scenarios, (list, tuple)) or not scenarios:
+        raise ModelError("scenarios: a non-empty list of override dicts {'part.key': value} is needed")
+    for k, d in enumerate(scenarios):
+        if not isinstance(d, dict):
+            raise ModelError(f"scenarios[{k}]: an override dict {{'part.key': value}} is needed, got {d!r}")
+    names = []
+    for d in scenarios:
+        names += [n for n in d if n not in names]
+    scenes = [scene.with_overrides(d) for d in scenarios]
+    for name in names:
+        for k, s in enumerate(scenes):
+            value = s.get(name)
+            if isinstance(value, str):
+                raise ModelError(f"scenarios[{k}]: {name} = {value!r}: a robust problem varies numeric scene values "
+                                 "only; solve one robust problem per model choice")
+    return tuple(names), scenes
+
+
+class RobustOCP:
+    """The multi-scenario collocation problem of a scene (see the module notes).
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+        The nominal scene (scales, initial state, baseline).
+    scenarios : list of dict
+        Override dicts, one per scenario (SI floats for numeric fields).
+    intervals, degree : int
+        Steps of the command grid over [0, t_max] (a scenario that locks at t_max has as many
+        collocation intervals) and collocation points per interval.
+    **ocp_options
+        Options of :class:`~clutchocp.optimal.problem.EngagementOCP` (rate_limit, h_min, jump,
+        lock_margin, smooth, polish, scheme); the command is piecewise linear.
+    """
+
+    def __init__(self, scene, scenarios, *, intervals=60, degree=3, **ocp_options):
+        if ocp_options.get("control", "linear") != "linear":
+            raise ModelError("control: the robust command is piecewise linear (control='linear')")
+        ocp_options.pop("control", None)
+        self.scene = scene
+        self.names, self.scenes = _check_scenarios(scene, scenarios)
+        self.overrides = [dict(d) for d in scenarios]
+        self.ocp = ParametricOCP(scene, self.names, intervals=intervals, degree=degree, **ocp_options)
+        self._ocp_options = dict(ocp_options, degree=degree)
+        self.thetas = np.array([self.ocp.nominal_theta(s) for s in self.scenes]).reshape(len(self.scenes), -1)
+        self.intervals = int(intervals)
+        self._nlps = {}
+        self._solvers = {}
+        self._fastest = None
+
+    @property
+    def n_scenarios(self):
+        return len(self.scenes)
+
+    # -- feasibility --------------------------------------------------------------------------
+    def fastest_lockups(self):
+        """Lock-up time of each scenario under a step of the command to the pressure limit [s] (IDAS, cached)."""
+        if self._fastest is None:
+            out = []
+            for k, s in enumerate(self.scenes):
+                t_end = s.value("simulation.t_end")
+                run = simulate_command(s, [0.0], [self.ocp.p_max], t_end)
+                t_lock = run.summary["engagement_time_s"]
+                if t_lock is None:
+                    raise ModelError(f"scenarios[{k}] {self.overrides[k]}: even a step to actuation.max_pressure does "
+                                     f"not lock up within simulation.t_end = {t_end:g} s")
+                out.append(t_lock)
+            self._fastest = np.array(out)
+        return self._fastest
+
+    # -- transcription ------------------------------------------------------------------------
+    def nlp(self, ocp, aggregate, t_max, lock_intervals):
+        """The robust NLP on ``ocp``'s functions for a command grid over [0, t_max] and the
+        command interval each scenario locks in."""
+        key = (id(ocp), aggregate, float(t_max), tuple(lock_intervals))
+        if key not in self._nlps:
+            self._nlps[key] = _transcribe(ocp, aggregate, t_max / ocp.scales.time_s, self.intervals,
+                                          tuple(int(k) for k in lock_intervals))
+        return self._nlps[key]
+
+    def solver(self, nlp, warm):
+        key = (id(nlp), warm)
+        if key not in self._solvers:
+            options = dict(IPOPT_OPTIONS, **(WARM_OPTIONS if warm else {}))
+            self._solvers[key] = ca.nlpsol(f"robust_{'warm' if warm else 'cold'}", "ipopt", nlp.nlp,
+                                           {"print_time": False, "ipopt": options, "error_on_fail": False})
+        return self._solvers[key]
+
+    # -- solving ------------------------------------------------------------------------------
+    def solve(self, *, t_max=None, weights=None, aggregate="mean", scenario_weights=None, max_shifts=40,
+              presolve_intervals=PRESOLVE_INTERVALS):
+        """Solve for the robust command (smooth stage, then the polish on the exact forms).
+
+        Parameters
+        ----------
+        t_max : float, optional
+            Latest lock-up of every scenario [s] (default: the nominal scene's, see
+            :meth:`EngagementOCP.default_t_max`).
+        weights : dict, optional
+            Objective weights by term (``OBJECTIVE_TERMS``), the same for every scenario.
+        aggregate : {"mean", "worst"}
+            Weighted mean of the scenario objectives, or the worst (epigraph).
+        scenario_weights : sequence of float, optional
+            Weights of the scenarios in the mean (normalised; default equal).
+        max_shifts : int
+            Largest number of re-solves per stage that move a scenario's lock-up into the next command interval.
+        presolve_intervals : int or None
+            First solve the problem on this coarser command grid (smooth model only), where a
+            re-solve moves a lock-up by a longer step, and start from its lock-up times and states
+            (None, or not fewer than ``intervals``: start from the scenarios' baseline runs).
+
+        Returns
+        -------
+        RobustEngagement
+
+        Raises
+        ------
+        ModelError
+            Bad weights, aggregate or t_max (below a scenario's fastest lock-up).
+        SolverError
+            IPOPT did not converge.
+        """
+        ocp = self.ocp
+        weights = check_weights(weights)
+        if aggregate not in AGGREGATES:
+            raise ModelError(f"aggregate '{aggregate}': allowed values are {', '.join(AGGREGATES)}")
+        if ocp.jump_mode == "penalty" and weights["jump"] == 0:
+            raise ModelError("weights.jump: must be > 0 when the jump is a penalty (jump='penalty')")
+        omega = np.ones(self.n_scenarios) if scenario_weights is None else np.asarray(scenario_weights, float)
+        if omega.shape != (self.n_scenarios,) or not np.all(np.isfinite(omega) & (omega >= 0)) or omega.sum() <= 0:
+            raise ModelError(f"scenario_weights: {self.n_scenarios} numbers >= 0 (not all zero) are needed")
+        omega = omega / omega.sum()
+        t_max = ocp.default_t_max() if t_max is None else float(t_max)
+        if not (np.isfinite(t_max) and t_max > 0):
+            raise ModelError(f"t_max = {t_max!r}: must be a positive, finite time [s]")
+        fastest = self.fastest_lockups()
+        if np.any(fastest > t_max):
+            k = int(np.argmax(fastest))
+            raise ModelError(f"t_max = {t_max:.4g} s is below the fastest lock-up of scenarios[{k}] "
+                             f"{self.overrides[k]} ({fastest[k]:.4g} s with a step to actuation.max_pressure); "
+                             "raise t_max or the pressure limit")
+        stages, start = [], None
+        if presolve_intervals is not None and presolve_intervals < self.intervals:
+            coarse = RobustOCP(self.scene, self.overrides, intervals=presolve_intervals,
+                               **dict(self._ocp_options, polish=False, baseline=ocp.baseline))
+            coarse._fastest = fastest
+            start = coarse._solve_model(coarse.ocp, t_max, weights, aggregate, omega, None, max_shifts, stages,
+                                        f"smooth, {presolve_intervals} intervals")
+            if not start.success:
+                start = None
+        result = self._solve_model(ocp, t_max, weights, aggregate, omega, start, max_shifts, stages, "smooth")
+        if ocp.polish and result.success:
+            polished = self._solve_model(ocp.exact, t_max, weights, aggregate, omega, result, max_shifts, stages,
+                                         "exact")
+            if polished.success:
+                result = polished
+        result.stats = dict(stages[-1], iterations=sum(s["iterations"] for s in stages),
+                            wall_time_s=sum(s["wall_time_s"] for s in stages), stages=stages,
+                            model=stages[-1]["model"] if result.success else stages[0]["model"])
+        if not result.success:
+            raise SolverError(f"robust engagement: IPOPT stopped with {result.stats['status']} (scene "
+                              f"'{self.scene.name}', {self.n_scenarios} scenarios, t_max = {t_max:.4g} s, "
+                              f"{result.stats['iterations']} iterations); try another t_max, fewer or nearer "
+                              "scenarios, or other weights")
+        return result
+
+    def _solve_model(self, ocp, t_max, weights, aggregate, omega, guess, max_shifts, stages, label):
+        """Solve on one model (smooth or exact), moving lock-ups between command intervals until
+        no scenario's lock-up sits on the end of its interval with a multiplier pushing it out."""
+        h_c = t_max / self.intervals
+        if guess is None:
+            t_guess = self._lock_guess(t_max)
+        else:
+            t_guess = guess.lock_times
+        lock_intervals = np.clip(np.ceil(t_guess / h_c - 1e-9).astype(int) - 1, 0, self.intervals - 1)
+        result = None
+        for _ in range(max_shifts + 1):
+            nlp = self.nlp(ocp, aggregate, t_max, lock_intervals)
+            warm = result is None and guess is not None and guess.w.size == nlp.lbx.size \
+                and tuple(guess.stats.get("lock_intervals", ())) == tuple(lock_intervals)
+            result = self._solve_stage(ocp, nlp, t_max, weights, aggregate, omega, guess if warm else None,
+                                       result or guess, warm)
+            stages.append(dict(result.stats, model=label))
+            # A lock-up interval no command meets shows as a local infeasibility, with the lock-up
+            # of the scenario at fault on a bound of its interval: move it there and solve again.
+            last = result
+            moves = nlp.interval_moves(result.w, result.lam_x, stuck=not result.success)
+            if not np.any(moves):
+                break
+            lock_intervals = lock_intervals + moves
+            if not result.success:
+                result = None
+        return result if result is not None else last
+
+    def start_runs(self, t_max):
+        """IDAS runs of every scenario under the start command: a ramp over the first command step
+        to the pressure limit, then held (cached per t_max).
+
+        The grid represents that command exactly, so the lock-up intervals it gives can be met:
+        the start is feasible. (Starting from the scenarios' own baseline runs put a fast and a
+        slow corner into the same last interval, which no command meets: measured, IPOPT reported
+        the 9-point box infeasible; a step at t = 0, which the rate limit on the grid does not
+        allow, gave lock-ups the grid cannot reach as soon.) Re-solves then move the lock-ups later.
+        """
+        key = float(t_max)
+        if getattr(self, "_start_key", None) != key:
+            h_c = t_max / self.intervals
+            times, values = [0.0, h_c], [self.ocp.scene.value("actuation.initial_pressure"), self.ocp.p_max]
+            self._start_runs = [simulate_command(s, times, values, 2.0 * t_max, control="linear") for s in self.scenes]
+            self._start_key = key
+            self._start_command = (times, values)
+        return self._start_runs
+
+    def _lock_guess(self, t_max):
+        """First guess of each scenario's lock-up [s]: under the start command (:meth:`start_runs`)."""
+        return np.array([min(r.summary["engagement_time_s"] or t_max, t_max) for r in self.start_runs(t_max)])
+
+    def _solve_stage(self, ocp, nlp, t_max, weights, aggregate, omega, warm_from, start_from, warm):
+        sc = ocp.scales
+        if warm:
+            w0, lam_x0, lam_g0 = warm_from.w.copy(), warm_from.lam_x, warm_from.lam_g
+        else:
+            w0 = self._guess(ocp, nlp, t_max, start_from)
+            lam_x0, lam_g0 = np.zeros_like(w0), np.zeros(nlp.lbg.size)
+        w0 = np.clip(w0, nlp.lbx, nlp.ubx)
+        p = np.concatenate([[weights[k] for k in OBJECTIVE_TERMS], self.thetas.ravel(), omega])
+        if aggregate == "worst" and not warm:                 # the epigraph variable starts on its bound
+            w0[nlp.tau_slice.stop:] = np.max(np.array(nlp.objectives_fn(w0, p)))
+        solver = self.solver(nlp, warm)
+        start = time.perf_counter()
+        sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg, p=p)
+        wall = time.perf_counter() - start
+        st = solver.stats()
+        stats = {"status": st["return_status"], "success": bool(st["success"]), "iterations": int(st["iter_count"]),
+                 "wall_time_s": wall, "warm_start": bool(warm), "n_variables": int(w0.size),
+                 "n_constraints": int(nlp.lbg.size), "n_scenarios": self.n_scenarios,
+                 "lock_intervals": [int(k) for k in nlp.lock_intervals]}
+        return self._result(ocp, nlp, np.array(sol["x"]).ravel(), np.array(sol["lam_x"]).ravel(),
+                            np.array(sol["lam_g"]).ravel(), float(sol["f"]), p, weights, aggregate, omega, t_max,
+                            stats, sc)
+
+    def _guess(self, ocp, nlp, t_max, previous):
+        """Start point: a previous robust solution interpolated onto this mesh, or each scenario's
+        run under a step of the command to the pressure limit (see :meth:`_lock_guess`)."""
+        sc = ocp.scales
+        t_lock = previous.lock_times if previous is not None else self._lock_guess(t_max)
+        T = nlp.clip_lock_times(t_lock / sc.time_s)
+        times = nlp.scenario_times(T)                           # scaled node / point times per scenario
+        xs, xcs = [], []
+        if previous is not None:
+            for k, opt in enumerate(previous.scenarios):
+                t_old = opt.t / sc.time_s
+
+                def at(t, opt=opt, t_old=t_old):
+                    cols = [np.interp(t, t_old, opt.states[name]) / nom for name, nom in zip(ocp.state_names,
+                                                                                          ocp.nominal)]
+                    cols.append(np.interp(t, t_old, opt.outputs["dissipated_energy_J"]) / sc.energy_J)
+                    return np.stack(cols, axis=-1)
+                xs.append(at(times[k][0]))
+                xcs.append(at(times[k][1]))
+            v = np.interp(nlp.command_grid, previous.command_times / sc.time_s, previous.command / sc.pressure_Pa)
+            return nlp.pack(xs, xcs, v, T)
+        tr = ocp.transcription
+        for k, run in enumerate(self.start_runs(t_max)):
+            parts = ocp.nlp.unpack(guess_from_run(ocp, run, t_max=t_max))
+            t_run = tr.node_times(parts["T"])[0]
+            xcol = [np.stack([np.interp(t, t_run, parts["x"][:, i]) for i in range(parts["x"].shape[1])], axis=-1)
+                    for t in times[k]]
+            xs.append(xcol[0])
+            xcs.append(xcol[1])
+        times_c, values_c = self._start_command
+        v = np.interp(nlp.command_grid * sc.time_s, times_c, values_c) / sc.pressure_Pa
+        return nlp.pack(xs, xcs, v, T)
+
+    def _result(self, ocp, nlp, w, lam_x, lam_g, objective, p, weights, aggregate, omega, t_max, stats, sc):
+        parts = nlp.unpack(w)
+        command = np.clip(parts["v"], 0.0, 1.0) * sc.pressure_Pa
+        J = np.array(nlp.objectives_fn(w, p)).ravel()
+        times = nlp.scenario_times(parts["T"])
+        scenarios = []
+        for k in range(self.n_scenarios):
+            ocp.theta_value = self.thetas[k]
+            scenarios.append(_scenario_result(ocp, nlp, parts, k, times[k], float(J[k]), weights, stats, t_max))
+        ocp.theta_value = ocp.nominal_theta(self.scene)
+        return RobustEngagement(nlp.command_grid * sc.time_s, command, scenarios, self.overrides, J, objective,
+                                aggregate, weights, omega, t_max, stats, w, lam_x, lam_g)
+
+
+def _scenario_result(ocp, nlp, parts, k, times, objective, weights, stats, t_max):
+    """One scenario of a robust solution as an OptimalEngagement (its own mesh, the shared command)."""
+    sc, d = ocp.scales, ocp.transcription.degree
+    starts, points = times
+    T = parts["T"][k]
+    x, xc = parts["x"][k], parts["xc"][k]
+    v = np.clip(parts["v"], 0.0, 1.0)
+    u_nodes = np.interp(starts, nlp.command_grid, v)
+    u_points = np.interp(points, nlp.command_grid, v)
+    outputs = ocp._evaluate(x, u_nodes)
+    outputs["dissipated_energy_J"] = x[:, -1] * sc.energy_J
+    flat = ocp._evaluate(xc.reshape(-1, xc.shape[-1]), u_points.ravel())
+    outputs_points = {name: value.reshape(points.shape) for name, value in flat.items()}
+    steps = np.diff(starts)[:, None]                             # scaled interval lengths
+    quad = ocp.transcription.B[None, :] * steps * sc.time_s
+    terms = {
+        "jerk_integral": float(np.sum(quad * outputs_points["output_jerk_rad_s3"] ** 2)),
+        "slip_jerk_integral": float(np.sum(quad * outputs_points["slip_jerk_rad_s3"] ** 2)),
+        "dissipated_energy_J": float(x[-1, -1] * sc.energy_J),
+        "engagement_time_s": T * sc.time_s,
+        "lockup_torque_jump_Nm": float(ocp.jump_fn(x[-1], u_nodes[-1])),
+        "final_slip_rad_s": float(outputs["w_rel_rad_s"][-1]),
+        "locked_torque_Nm": float(outputs["locked_torque_Nm"][-1]),
+        "peak_jerk_rad_s3": float(np.max(np.abs(outputs_points["output_jerk_rad_s3"]))),
+        "peak_torque_Nm": float(np.max(np.abs(outputs_points["total_torque_Nm"]))),
+        "objective": objective,
+    }
+    nominal = ocp.nominal
+    states = {member: x[:, i] * nominal[i] for i, name in enumerate(ocp.state_names)
+              for member in ocp.state_groups[name]}
+    empty = np.zeros(0)
+    result = OptimalEngagement(T * sc.time_s, starts * sc.time_s, points * sc.time_s, starts * sc.time_s,
+                               u_nodes * sc.pressure_Pa, "linear", states, outputs, outputs_points, terms, objective,
+                               dict(stats), empty, empty, empty, weights)
+    result.t_max = t_max
+    return result
+
+
+@dataclass
+class _RobustNLP:
+    """The robust NLP and how to read its variables (scaled units).
+
+    Scenario s has ``lock_intervals[s]`` = K_s full command intervals, then a last interval of free
+    length tau_s in (0, h_c] (its lock-up at T_s = K_s h_c + tau_s).
+    """
+
+    nlp: dict
+    lbx: np.ndarray
+    ubx: np.ndarray
+    lbg: np.ndarray
+    ubg: np.ndarray
+    x_offsets: list                    # (start, n_nodes) of each scenario's node states in w
+    xc_offsets: list                   # (start, n_points) of each scenario's point states in w
+    v_slice: slice
+    tau_slice: slice
+    n_x: int
+    degree: int
+    tau: np.ndarray                    # collocation points in (0, 1]
+    h_c: float
+    lock_intervals: tuple
+    command_grid: np.ndarray           # scaled times of the command nodes
+    objectives_fn: ca.Function         # (w, p) -> J_s of each scenario
+    tau_min: float
+
+    @property
+    def t_upper(self):
+        return self.command_grid[-1]
+
+    def unpack(self, w):
+        w = np.asarray(w, float).ravel()
+        d, n_x = self.degree, self.n_x
+        x = [w[a:a + n * n_x].reshape(n, n_x) for a, n in self.x_offsets]
+        xc = [w[a:a + n * n_x].reshape(n // d, d, n_x) for a, n in self.xc_offsets]
+        tau = w[self.tau_slice]
+        T = np.array(self.lock_intervals) * self.h_c + tau
+        return {"x": x, "xc": xc, "v": w[self.v_slice], "tau": tau, "T": T}
+
+    def pack(self, x, xc, v, T):
+        w = np.zeros(self.lbx.size)
+        for (a, n), xs in zip(self.x_offsets, x):
+            w[a:a + n * self.n_x] = np.asarray(xs, float).ravel()
+        for (a, n), xcs in zip(self.xc_offsets, xc):
+            w[a:a + n * self.n_x] = np.asarray(xcs, float).ravel()
+        w[self.v_slice] = v
+        w[self.tau_slice] = np.asarray(T, float) - np.array(self.lock_intervals) * self.h_c
+        return w
+
+    def clip_lock_times(self, T):
+        """Scaled lock times moved into each scenario's lock interval."""
+        K = np.array(self.lock_intervals)
+        return np.clip(T, K * self.h_c + self.tau_min, (K + 1) * self.h_c)
+
+    def scenario_times(self, T=None):
+        """Scaled (node times, point times (K+1, d)) of each scenario (at lock times T, default the
+        end of each lock interval)."""
+        K = np.array(self.lock_intervals)
+        T = (K + 1) * self.h_c if T is None else np.asarray(T, float)
+        out = []
+        for Ks, Ts in zip(K, T):
+            starts = np.append(np.arange(Ks + 1) * self.h_c, Ts)
+            steps = np.diff(starts)
+            out.append((starts, starts[:-1, None] + steps[:, None] * self.tau[None, :]))
+        return out
+
+    def interval_moves(self, w, lam_x, tol=1e-6, stuck=False):
+        """+1 / -1 for a scenario whose lock-up sits on the end / start of its command interval with a
+        multiplier pushing it beyond (and a next / previous interval exists), else 0.
+
+        ``stuck``: the solve failed; move every lock-up that sits on a bound (multipliers ignored).
+        """
+        tau, lam = w[self.tau_slice], lam_x[self.tau_slice]
+        K = np.array(self.lock_intervals)
+        n_int = self.command_grid.size - 1
+        at_end = tau >= self.h_c * (1 - (1e-3 if stuck else 1e-6))
+        at_start = tau <= self.tau_min + (1e-3 * self.h_c if stuck else 1e-3 * self.tau_min)
+        up = at_end & ((lam > tol) | stuck) & (K < n_int - 1)
+        down = at_start & ((lam < -tol) | stuck) & (K > 0)
+        return up.astype(int) - down.astype(int)
+
+
+def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
+    """Transcribe the robust problem on the functions of ``ocp`` (see :class:`_RobustNLP`).
+
+    The NLP parameter is ``[weights (5); theta of each scenario; scenario weights]``.
+    """
+    tr, prob = ocp.transcription, ocp._staged_problem()
+    d, tau = tr.degree, tr.tau
+    n_x, n_th, n_s = prob.n_x, ocp.theta.numel(), len(lock_intervals)
+    h_c = t_grid_end / n_int
+    tau_min = 1e-3 * h_c
+    grid = np.arange(n_int + 1) * h_c
+    K = np.array(lock_intervals)
+    n_nodes, n_ints = K + 2, K + 1
+    X = [ca.MX.sym(f"X{s}", n_x, int(n_nodes[s])) for s in range(n_s)]
+    Xc = [ca.MX.sym(f"Xc{s}", n_x, int(n_ints[s]) * d) for s in range(n_s)]
+    V = ca.MX.sym("V", n_int + 1)
+    tau_s = ca.MX.sym("tau", n_s)
+    z = ca.MX.sym("z", 1 if aggregate == "worst" else 0)
+    W = ca.MX.sym("weights", len(OBJECTIVE_TERMS))
+    Theta = ca.MX.sym("theta", n_th, n_s)
+    omega = ca.MX.sym("omega", n_s)
+    w = ca.veccat(*X, *Xc, V, tau_s, z)
+    x_offsets, xc_offsets, start = [], [], 0
+    for s in range(n_s):
+        x_offsets.append((start, int(n_nodes[s])))
+        start += int(n_nodes[s]) * n_x
+    for s in range(n_s):
+        xc_offsets.append((start, int(n_ints[s]) * d))
+        start += int(n_ints[s]) * d * n_x
+    v_slice = slice(start, start + n_int + 1)
+    tau_slice = slice(v_slice.stop, v_slice.stop + n_s)
+
+    # Command and step at every collocation point: interval i < K_s of scenario s is command interval
+    # i (step h_c, u = V_i + (V_{i+1} - V_i) tau_j); its last interval K_s has the step tau_s and
+    # u = V_K + (V_{K+1} - V_K) tau_s tau_j / h_c.
+    left_idx, frac, step = [], [], []
+    for s in range(n_s):
+        for i in range(int(n_ints[s])):
+            left_idx += [i] * d
+            if i < K[s]:
+                frac.append(ca.DM(tau).T)
+                step.append(ca.DM.ones(1, d) * h_c)
+            else:
+                frac.append(tau_s[s] * ca.DM(tau).T / h_c)
+                step.append(ca.repmat(tau_s[s], 1, d))
+    frac, step = ca.horzcat(*frac), ca.horzcat(*step)
+    left = V[left_idx].T
+    right = V[[i + 1 for i in left_idx]].T
+    Uc = left + (right - left) * frac
+    n_pts = len(left_idx)
+    P_pts = ca.vertcat(ca.repmat(W, 1, n_pts),
+                       ca.horzcat(*[ca.repmat(Theta[:, s], 1, int(n_ints[s]) * d) for s in range(n_s)]))
+    xdot, q, c = prob.dynamics.map(n_pts)(ca.horzcat(*Xc), Uc, P_pts)
+
+    B = np.asarray(tr.B)
+    colloc, continuity, g_end, J_s = [], [], [], []
+    col = 0
+    for s in range(n_s):
+        ni = int(n_ints[s])
+        cols = slice(col, col + ni * d)
+        col += ni * d
+        Xs, Xcs = X[s], Xc[s]
+        Cin = _sparse(np.kron(np.eye(ni), tr.C[1:]))
+        Dm = _sparse(np.kron(np.eye(ni), tr.D[1:, None]))
+        C0 = np.repeat(np.tile(tr.C[0], ni)[None, :], n_x, axis=0)
+        hs = step[:, cols]
+        colloc.append(ca.vec(_repeat_columns(Xs[:, :-1], d) * ca.DM(C0) + ca.mtimes(Xcs, Cin)
+                             - ca.repmat(hs, n_x, 1) * xdot[:, cols]))
+        continuity.append(ca.vec(Xs[:, 1:] - (Xs[:, :-1] * tr.D[0] + ca.mtimes(Xcs, Dm))))
+        Q = ca.mtimes(q[:, cols] * ca.repmat(hs, q.size1(), 1), ca.DM(np.tile(B, ni)))
+        T_s = K[s] * h_c + tau_s[s]
+        u_f = V[int(K[s])] + (V[int(K[s]) + 1] - V[int(K[s])]) * tau_s[s] / h_c
+        p_s = ca.vertcat(W, Theta[:, s])
+        J_s.append(prob.objective(Xs[:, -1], u_f, Q, T_s, p_s))
+        g_end.append(prob.end(Xs[:, -1], u_f, T_s, p_s))
+    J_all = ca.vertcat(*J_s)
+    n_e = prob.end_lb.size
+    end_lb, end_ub = prob.end_lb.copy(), prob.end_ub.copy()
+    end_lb[-1], end_ub[-1] = -np.inf, np.inf                 # energy row: no e_max in the robust problem
+    blocks = [(ca.vertcat(*colloc), 0.0, 0.0), (ca.vertcat(*continuity), 0.0, 0.0),
+              (ca.vec(c), np.tile(prob.c_lb, n_pts), np.tile(prob.c_ub, n_pts)),
+              (ca.vertcat(*g_end), np.tile(end_lb, n_s), np.tile(end_ub, n_s))]
+    if prob.u_rate is not None:
+        limit = float(prob.u_rate[0]) * h_c
+        blocks.append((V[1:] - V[:-1], -limit, limit))
+    if aggregate == "worst":
+        f = z
+        blocks.append((J_all - z, -np.inf, 0.0))
+    else:
+        f = ca.dot(omega, J_all)
+    g = ca.vertcat(*[b[0] for b in blocks])
+    lbg = np.concatenate([np.broadcast_to(b[1], (b[0].numel(),)) for b in blocks])
+    ubg = np.concatenate([np.broadcast_to(b[2], (b[0].numel(),)) for b in blocks])
+    assert n_e * n_s == blocks[3][0].numel()
+
+    n_w = w.numel()
+    lbx, ubx = np.full(n_w, -np.inf), np.full(n_w, np.inf)
+    for (a, n) in x_offsets + xc_offsets:
+        lbx[a:a + n * n_x] = np.tile(prob.x_lb, n)
+        ubx[a:a + n * n_x] = np.tile(prob.x_ub, n)
+    for a, _ in x_offsets:                                 # every scenario starts from the initial state
+        lbx[a:a + n_x] = ubx[a:a + n_x] = prob.x0
+    lbx[v_slice], ubx[v_slice] = prob.u_lb[0], prob.u_ub[0]
+    if prob.u_initial is not None and prob.u_rate is not None:
+        lbx[v_slice.start] = ubx[v_slice.start] = prob.u_initial[0]     # no step at t = 0
+    lbx[tau_slice], ubx[tau_slice] = tau_min, h_c
+    P = ca.vertcat(W, ca.vec(Theta), omega)
+    nlp = {"x": w, "f": f, "g": g, "p": P}
+    objectives_fn = ca.Function("scenario_objectives", [w, P], [J_all])
+    return _RobustNLP(nlp, lbx, ubx, lbg, ubg, x_offsets, xc_offsets, v_slice, tau_slice, n_x, d, np.asarray(tau),
+                      h_c, tuple(int(k) for k in K), grid, objectives_fn, tau_min)
+
+
+def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean", intervals=60, degree=3,
+                 scenario_weights=None, presolve_intervals=PRESOLVE_INTERVALS, **ocp_options):
+    """One pressure command for several scenarios of a clutch (see the module notes).
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+        The nominal scene.
+    scenarios : list of dict
+        Override dicts ``{"part.key": SI value}`` (e.g. ``Uncertainty.corners()``), one per scenario.
+    t_max : float, optional
+        Latest lock-up of every scenario [s] (default: the nominal baseline's lock-up time).
+    weights : dict, optional
+        Objective weights by term (jerk, energy, time, jump, smooth).
+    aggregate : {"mean", "worst"}
+    intervals, degree : int
+        Steps of the command grid over [0, t_max] and collocation points per interval.
+    scenario_weights : sequence of float, optional
+        Weights of the scenarios in the mean.
+    presolve_intervals : int or None
+        Command steps of the coarse first solve that finds the lock-up intervals (see :meth:`RobustOCP.solve`).
+    **ocp_options
+        Options of :class:`~clutchocp.optimal.problem.EngagementOCP`.
+
+    Returns
+    -------
+    RobustEngagement
+    """
+    problem = RobustOCP(scene, scenarios, intervals=intervals, degree=degree, **ocp_options)
+    return problem.solve(t_max=t_max, weights=weights, aggregate=aggregate, scenario_weights=scenario_weights,
+                         presolve_intervals=presolve_intervals)

@@ -1,0 +1,133 @@
+"""Robust feedforward: the multi-scenario collocation problem (clutchocp.optimal.robust)."""
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from clutchocp.errors import ModelError
+from clutchocp.optimal.problem import SLIP_MODE, EngagementOCP
+from clutchocp.optimal.robust import ParametricOCP, RobustOCP, solve_robust
+from clutchocp.scene import default_scene
+
+N = 10                # no coarse presolve (PRESOLVE_INTERVALS) below this
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return default_scene()
+
+
+@pytest.fixture(scope="module")
+def nominal(scene):
+    ocp = EngagementOCP(scene, intervals=N)
+    return ocp, ocp.solve()
+
+
+def test_parametric_dynamics_equal_the_overridden_scene(scene, nominal):
+    """theta in the symbols gives the model of the scene with those values (a second build)."""
+    ocp, _ = nominal
+    names = ("friction.mu", "oil.viscosity", "load.torque")
+    par = ParametricOCP(scene, names, intervals=3, baseline=ocp.baseline)
+    values = {"friction.mu": 0.131, "oil.viscosity": 0.05, "load.torque": 117.0}
+    other = EngagementOCP(scene.with_overrides(values), intervals=3, baseline=ocp.baseline)
+    other.scales = par.scales                         # same scaling, so the functions compare 1:1
+    other._build_functions()
+    rng = np.random.default_rng(3)
+    theta = [values[n] for n in names]
+    weights = [1.0, 0.3, 0.2, 0.5, 0.1]
+    for _ in range(3):
+        x = np.append(par.x0 / par.nominal, 0.0) * rng.uniform(0.3, 1.2, par.x0.size + 1)
+        u = rng.uniform(0.1, 0.9)
+        for a, b in zip(par.dynamics_fn(x, u, weights + theta), other.dynamics_fn(x, u, weights)):
+            np.testing.assert_allclose(np.array(a), np.array(b), rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(np.array(par.end_fn(x, u, 1.0, weights + theta)),
+                                   np.array(other.end_fn(x, u, 1.0, weights)), rtol=1e-12, atol=1e-14)
+    assert SLIP_MODE in par.model.modes
+
+
+def test_one_scenario_is_the_nominal_problem(scene, nominal):
+    ocp, opt = nominal
+    assert opt.t_f == pytest.approx(opt.t_max, rel=1e-6)      # the jerk optimum uses all the time
+    res = solve_robust(scene, [{}], intervals=N)
+    assert res.success
+    assert res.objective == pytest.approx(opt.objective, rel=1e-6)
+    np.testing.assert_allclose(res.command, np.interp(res.command_times, opt.command_times, opt.command),
+                               atol=1e-5 * ocp.p_max)
+    assert res.lock_times[0] == pytest.approx(opt.t_f, rel=1e-6)
+    terms = res.scenarios[0].terms
+    assert terms["jerk_integral"] == pytest.approx(opt.terms["jerk_integral"], rel=1e-5)
+    assert terms["lockup_torque_jump_Nm"] == pytest.approx(opt.terms["lockup_torque_jump_Nm"], rel=1e-5)
+
+
+@pytest.mark.slow
+def test_two_identical_scenarios_give_the_nominal_answer(scene, nominal):
+    _, opt = nominal
+    same = {"friction.mu": scene.value("friction.mu")}
+    res = solve_robust(scene, [same, same], intervals=N)
+    assert res.objective == pytest.approx(opt.objective, rel=1e-6)
+    np.testing.assert_allclose(res.objectives, opt.objective, rtol=1e-6)
+
+
+@pytest.mark.slow
+def test_worst_of_one_scenario_is_the_nominal_problem(scene, nominal):
+    _, opt = nominal
+    res = solve_robust(scene, [{}], intervals=N, aggregate="worst")
+    assert res.objective == pytest.approx(opt.objective, rel=1e-6)
+
+
+@pytest.fixture(scope="module")
+def spread(scene):
+    mu = scene.value("friction.mu")
+    problem = RobustOCP(scene, [{"friction.mu": 0.95 * mu}, {"friction.mu": 1.05 * mu}], intervals=N,
+                        jump="penalty", polish=False)
+    weights = {"jump": 30.0}
+    return problem, problem.solve(weights=weights), problem.solve(weights=weights, aggregate="worst")
+
+
+@pytest.mark.slow
+def test_worst_aggregate_bounds_the_mean(spread):
+    _, mean, worst = spread
+    assert worst.objective == pytest.approx(worst.objectives.max(), rel=1e-6)
+    # The worst-case optimum is no better in its worst scenario than the mean optimum is on average,
+    # and no worse in its worst scenario than the mean optimum's worst.
+    assert worst.objective >= mean.objective * (1 - 1e-6)
+    assert worst.objective <= mean.objectives.max() * (1 + 1e-6)
+    assert mean.objective == pytest.approx(mean.objectives.mean(), rel=1e-9)
+
+
+@pytest.mark.slow
+def test_every_scenario_meets_its_end_conditions(spread):
+    problem, mean, _ = spread
+    for res in mean.scenarios:
+        assert abs(res.terms["final_slip_rad_s"]) < 1e-6
+        assert res.t_f <= mean.t_max * (1 + 1e-7)        # IPOPT relaxes bounds by 1e-8 (bound_relax_factor)
+        assert res.outputs["capacity_rate_Nm_s"][-1] >= -1e-6 * abs(res.terms["locked_torque_Nm"])
+    # the faster (higher mu) scenario locks first; the shared command is within its limits
+    assert mean.lock_times[1] < mean.lock_times[0]
+    assert np.all(mean.command >= 0) and np.all(mean.command <= problem.ocp.p_max)
+    rate = np.diff(mean.command) / np.diff(mean.command_times)
+    assert np.max(np.abs(rate)) <= problem.ocp.rate_limit * (1 + 1e-6)
+
+
+def test_bad_requests_are_model_errors(scene, nominal):
+    ocp, _ = nominal
+    with pytest.raises(ModelError, match="scenarios"):
+        RobustOCP(scene, [], intervals=N)
+    with pytest.raises(ModelError, match="numeric"):
+        RobustOCP(scene, [{"film.flow_factor": "none"}], intervals=N)
+    problem = RobustOCP(scene, [{"friction.mu": 0.12}], intervals=N, baseline=ocp.baseline)
+    with pytest.raises(ModelError, match="aggregate"):
+        problem.solve(aggregate="median")
+    with pytest.raises(ModelError, match="scenario_weights"):
+        problem.solve(scenario_weights=[1.0, 2.0])
+    with pytest.raises(ModelError, match="fastest lock-up"):
+        problem.solve(t_max=0.05)
+    with pytest.raises(ModelError, match="control"):
+        RobustOCP(scene, [{}], intervals=N, control="constant")
+
+
+def test_a_value_the_model_cannot_take_as_a_symbol_is_named(scene, nominal):
+    ocp, _ = nominal
+    with pytest.raises(ModelError, match="plates.n_interfaces"):
+        ParametricOCP(scene, ("plates.n_interfaces",), intervals=3, baseline=ocp.baseline)
+    assert isinstance(ca.SX.sym("x"), ca.SX)

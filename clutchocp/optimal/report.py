@@ -71,7 +71,9 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     check, replay = verify(verifier, opt, model=command_model)
     say(f"  IDAS re-simulation: lock-up {_fmt(check['idas']['engagement_time_s'], 's')}, "
         f"jump {_fmt(check['torque_jump_Nm'], 'N m')}")
-    fill = _fill_comparison(ocp, opt, check, command_model, intervals, degree, say) if len(opt.phases) > 1 else None
+    # the calibration shape "fill pulse, hold, ramp" is that of a pressure-applied piston
+    fill = _fill_comparison(ocp, opt, check, command_model, intervals, degree, say) \
+        if len(opt.phases) > 1 and ocp.apply_pressure > 0 else None
     baselines = simulate_baselines(scene)
     w_rel0, rate0 = ocp.initial_slip()
     bound = jerk_lower_bound(w_rel0, rate0, opt.t_f)

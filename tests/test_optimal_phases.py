@@ -226,3 +226,17 @@ def test_quasi_static_plates_match_the_plate_masses_of_bao2020():
     kisses = [next(e.t for e in r.result.events if e.name == "impact") for r in runs]
     assert locks[0] == pytest.approx(locks[1], rel=1e-4)
     assert kisses[0] == pytest.approx(kisses[1], rel=1e-4)
+
+
+@pytest.mark.slow
+def test_spring_applied_bao2020_optimum_is_confirmed_by_idas():
+    """bao2020: the command shapes the release; quasi-static plates in the OCP, IDAS on the plate masses."""
+    scene = load_scene("bao2020", {"actuation.max_pressure": "80 MPa", "actuation.initial_pressure": "63.66 MPa"})
+    ocp = EngagementOCP(scene, intervals=60)
+    assert ocp.quasi_static_plates and ocp.apply_pressure == 0.0 and not ocp.holds_torque
+    opt = ocp.solve()
+    check, _ = verify(ocp.exact, opt)
+    assert check["passed"] and check["lock_time_rel_diff"] <= 0.01
+    assert abs(check["torque_jump_Nm"]) <= 0.02 * check["idas"]["peak_torque_Nm"]
+    assert check["holding_pressure_Pa"] == 0.0                  # after lock-up the spring clamps
+    assert check["idas"]["kiss_speed_m_s"] == pytest.approx(opt.terms["kiss_speed_m_s"], rel=1e-4)

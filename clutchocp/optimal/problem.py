@@ -6,6 +6,9 @@ sequence of phases (:mod:`clutchocp.optimal.phases`): with free piston travel a 
 ends when the piston reaches the pack (x0 = travel, the kiss point), the impact reset (Bao Eq. 22,
 the simulator's own reset map), then the ``slip`` phase (mode ``pressing_slip_forward``) up to
 lock-up. Without free travel the slip phase is the only phase, and the problem is the one below.
+Plate masses (``pack.model = "masses"``, bao2020) are taken as massless in the OCP: their axial
+dynamics is overdamped and 1e5-1e8 times faster than the slip (PHYSICS.md), which no mesh of the
+engagement resolves; the IDAS verification replays the optimum on the full model.
 
 Over the slip phase the pressure command u(t) is chosen to minimise
 

@@ -121,7 +121,9 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
     check, replay = verify(verifier, opt, model=command_model)
     say(f"  IDAS re-simulation: lock-up {_fmt(check['idas']['engagement_time_s'], 's')}, "
         f"jump {_fmt(check['torque_jump_Nm'], 'N m')}")
-    fill = _fill_comparison(ocp, opt, check, command_model, intervals, degree, say) if len(opt.phases) > 1 else None
+    # the calibration shape "fill pulse, hold, ramp" is that of a pressure-applied piston
+    fill = _fill_comparison(ocp, opt, check, command_model, intervals, degree, say) \
+        if len(opt.phases) > 1 and ocp.apply_pressure > 0 else None
     curve, whole = _clamp_curve(scene, ocp, opt, command_model, clamp_margin)
     say(f"  after lock-up: ramp to the clamp pressure {curve.clamp_pressure_Pa / 1e6:.4g} MPa by "
         f"{curve.ramp_end_s:.4g} s (capacity {curve.margin:g} x the locked torque); lock held in the IDAS replay: "
@@ -425,6 +427,7 @@ def plot_piston(out, scene, replay, baseline):
     """Piston travel, speed and spring force of the optimum (IDAS replay) and the scene's own profile."""
     fig, (ax1, ax2) = new_figure(2, width=4.8)
     runs = (("optimal (IDAS replay)", replay, "C0"), ("scene profile", baseline, "C3"))
+    kisses = []
     for label, run, color in runs:
         res = run.result
         ax1.plot(res.t * 1e3, res["x0"] * 1e3, color=color, label=f"{label}: travel")
@@ -432,14 +435,16 @@ def plot_piston(out, scene, replay, baseline):
         ax2.plot(res.t * 1e3, res["pressure_Pa"] * scene.value("piston.area"), color=color, ls="--",
                  label=f"{label}: pressure x area")
         kiss = [e.t for e in res.events if e.name == "impact"]
+        kisses += kiss
         for t in kiss:
             ax1.axvline(t * 1e3, color=color, lw=0.8, ls=":")
     t_end = 1.5 * max(run.summary["engagement_time_s"] or run.result.t[-1] for _, run, _ in runs)
     travel = scene.get("piston.travel_to_pack", 0.0)
     if travel > 0:
         ax1.axhline(travel * 1e3, color="k", lw=0.8, ls=":", label="kiss point (pack reached)")
-    ax1.set(xlabel="time [ms]", ylabel="piston travel [mm]", title=f"{scene.name}: piston stroke",
-            xlim=(0, t_end * 1e3))
+    # the stroke takes milliseconds: show it up to 4 x the later kiss (dotted lines)
+    ax1.set(xlabel="time [ms]", ylabel="piston travel [mm]", title=f"{scene.name}: piston stroke to the kiss point",
+            xlim=(0, (4 * max(kisses) if kisses else t_end) * 1e3))
     ax2.set(xlabel="time [ms]", ylabel="force [N]", title="spring force and hydraulic force", xlim=(0, t_end * 1e3))
     ax1.legend(fontsize=7)
     ax2.legend(fontsize=7)

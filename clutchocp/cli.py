@@ -266,29 +266,23 @@ def _cmd_bench(args):
 
 def _cmd_sweep(args):
     from .scene import parse_override
-    from .study import StudyInterrupted, run_sweep
+    from .study import run_sweep
 
     if args.scheduler and args.engine not in (None, "dask"):
-        raise ModelError(f"--scheduler {args.scheduler}: needs --engine dask (or no --engine)")
+        raise OptionError(f"--scheduler {args.scheduler}: needs --engine dask (or no --engine)")
     engine = args.engine or ("dask" if args.scheduler else "local")
     options = {}
     if args.task == "simulate":
-        if args.output_points is not None and args.output_points < 2:
-            raise ModelError(f"--output-points {args.output_points}: must be >= 2")
         options.update(native={"auto": "auto", "on": True, "off": False}[args.native],
                        output_points=args.output_points, reuse_model=not args.model_per_point)
     else:
         options.update(intervals=args.intervals, degree=args.degree, t_max=args.t_max,
                        weights=parse_weights(args.weights) if args.weights is not None else None,
                        warm_start=not args.cold, verify=not args.no_verify)
-    try:
-        summary = run_sweep(args.scene, args.out, task=args.task, grid=args.grid, samples=args.samples,
-                            seed=args.seed, uncertain=args.uncertain,
-                            overrides=dict(parse_override(text) for text in args.set), options=options,
-                            engine=engine, workers=args.workers, scheduler=args.scheduler, progress=True)
-    except StudyInterrupted as exc:
-        print(f"clutchocp sweep: {exc}", file=sys.stderr)
-        return 130
+    summary = run_sweep(args.scene, args.out, task=args.task, grid=args.grid, samples=args.samples,
+                        seed=args.seed, uncertain=args.uncertain,
+                        overrides=dict(parse_override(text) for text in args.set), options=options,
+                        engine=engine, workers=args.workers, scheduler=args.scheduler, progress=True)
     rate = summary["points_per_second"]
     print(f"{summary['scene']} {summary['task']} sweep: {summary['points']} points, {summary['points_ok']} ok, "
           f"{summary['points_failed']} failed, {summary['points_resumed']} resumed; "
@@ -458,6 +452,9 @@ def main(argv=None):
     except SystemExit as exc:            # argparse: --help (0) or a bad option (2, already printed)
         return exc.code if isinstance(exc.code, int) else 2
     except KeyboardInterrupt as exc:
+        if getattr(exc, "keeps_results", False):      # a study: the points finished so far stay written
+            print(f"{name}: {exc}", file=sys.stderr)
+            return 130
         where = str(exc) if isinstance(exc, interrupt.UserInterrupt) and str(exc) else "interrupted by the user"
         print(f"{name}: {where}; stopped, no results written", file=sys.stderr)
         return 130

@@ -77,6 +77,9 @@ def test_by_default_one_model_serves_every_point_and_agrees_with_the_single_runs
         for key in SIMULATE_RESULTS[:-1]:
             # the same equations with the values as parameters (constants folded in another order;
             # measured: 1e-14 relative); compiled C or CasADi's virtual machine
+            if single[key] is None:                   # e.g. a point that does not lock up within t_end
+                assert row[key] is None, key
+                continue
             assert row[key] == pytest.approx(single[key], rel=1e-9, abs=1e-9 * abs(single["peak_torque_Nm"])), key
     assert rows[0]["build_time_s"] == 0.0
 
@@ -160,7 +163,7 @@ def test_a_sweep_into_a_folder_another_sweep_is_writing_is_refused_before_any_ru
     (["--grid", "oil.viscosty=0.02:0.06:3"], ["oil.viscosty", "did you mean 'viscosity'"]),
     (["--grid", "oil.viscosity=0.02:0.06:3", "--samples", "5"], ["--grid", "--samples", "not both"]),
     ([], ["--grid", "--samples"]),
-    (["--grid", "oil.viscosity=0.02:0.06:3", "--workers", "0"], ["--workers", ">= 1"]),
+    (["--grid", "oil.viscosity=0.02:0.06:3", "--workers", "0"], ["--workers", "from 1"]),
     (["--grid", "oil.viscosity=0.02:0.06:3", "--scheduler", "tcp://127.0.0.1:1", "--engine", "local"],
      ["--scheduler", "--engine dask"]),
 ])
@@ -172,14 +175,21 @@ def test_bad_sweep_input_is_one_line_and_exit_code_2(tmp_path, capsys, args, wor
     assert all(w in lines[0] for w in words)
 
 
+# The roughness split equally between the surfaces: there the optimum of each point is unique. With the
+# lining rough and the separator smooth (the scene's own), the jerk optimum has several local optima
+# (measured at 12 intervals, 110 N m: 1.6392 cold, 1.6001 warm from the 90 N m optimum; at 24 intervals
+# 1.6574 cold, 1.6946 warm), so "the same optimum" would test IPOPT's luck, not the chain.
+EQUAL_SPLIT = {"roughness.sigma_1": 8.41e-6 / 2**0.5, "roughness.sigma_2": 8.41e-6 / 2**0.5}
+
+
 def test_an_optimize_chain_warm_starts_and_finds_the_cold_optimum(tmp_path):
     options = {"intervals": 12, "verify": False}
     run_sweep("default_driveline", tmp_path / "s", task="optimize", grid=["load.torque=90:110:2"],
-              options=options, engine="serial", progress=False)
+              overrides=EQUAL_SPLIT, options=options, engine="serial", progress=False)
     rows = read_rows(tmp_path / "s")
     assert [r["status"] for r in rows] == ["ok", "ok"]
     assert [r["warm_start"] for r in rows] == [False, True]
-    scene = load_scene("default_driveline", overrides={"load.torque": rows[1]["load.torque"]})
+    scene = load_scene("default_driveline", overrides=dict(EQUAL_SPLIT, **{"load.torque": rows[1]["load.torque"]}))
     cold = EngagementOCP(scene, intervals=12).solve()
     # the same optimum (measured: warm and cold agree to 1e-14; IPOPT's tolerance allows more)
     assert rows[1]["objective"] == pytest.approx(cold.objective, rel=1e-8)

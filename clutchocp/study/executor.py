@@ -29,6 +29,8 @@ ENGINES = ("local", "dask", "serial")
 class StudyInterrupted(KeyboardInterrupt):
     """The study was stopped by Ctrl-C after ``done`` points (all of them written)."""
 
+    keeps_results = True      # the command line says so instead of "no results written"
+
     def __init__(self, done, total):
         super().__init__(f"interrupted after {done} of {total} points; the finished points are kept "
                          "(run the same command again to resume)")

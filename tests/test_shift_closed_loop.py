@@ -43,7 +43,7 @@ def test_closed_loop_on_the_nominal_clutch_reproduces_the_open_loop_optimum(desi
 def test_feedback_cuts_the_jump_on_a_clutch_with_less_friction(designed):
     scene, opt, design, times, values = designed
     other = scene.with_overrides({"friction.mu": 0.9 * scene.value("friction.mu")})
-    t_end = 1.5 * opt.t_f
+    t_end = 2.5 * opt.t_f          # the open loop locks late (measured: 1.78 t_f)
     closed, tcu = run_closed_loop(other, design.feedback, t_end, nominal_scene=scene)
     a, b = run_numbers(run_open_loop(other, times, values, t_end)), run_numbers(closed)
     assert a["engagement_time_s"] is not None and b["engagement_time_s"] is not None

@@ -37,8 +37,8 @@ def test_bad_specs_raise_one_line(raw, match):
 
 
 @pytest.mark.parametrize("argv, match", [
-    (["robust", "--samples", "0"], "samples = 0: must be a whole number >= 1"),
-    (["robust", "--workers", "0"], "workers = 0: must be a whole number >= 1"),
+    (["robust", "--samples", "0"], "--samples: 0: samples from 1"),
+    (["robust", "--workers", "0"], "--workers: 0: parallel processes from 1"),
     (["robust", "--uncertain", "friction.mu=uniform ten %"], "friction.mu"),
     (["robust", "--uncertain", "friction.nu=uniform 10 %"], "friction.nu"),
     (["robust", "--controller", "no_such_spec"], "no_such_spec"),

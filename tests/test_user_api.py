@@ -167,8 +167,11 @@ def best():
 def test_optimize_result_repr_table_and_plot(best, tmp_path):
     assert len(repr(best)) < 300 and len(repr(best.optimum)) < 300 and best.success
     table = best.table()
-    assert list(table) == ["time_s", "pressure_command_Pa", "pressure_Pa"]
-    assert table["time_s"][-1] == pytest.approx(best.optimum.t_f)
+    assert list(table) == ["time_s", "pressure_command_Pa", "pressure_Pa", "phase", "to_next"]
+    # the whole usable curve: the engagement up to lock-up, then the ramp to the clamp pressure and its hold
+    lock_row = list(table["time_s"]).index(best.optimum.t_f)
+    assert table["phase"][lock_row] == "clamp_ramp" and table["phase"][-1] == "clamp_hold"
+    assert table["time_s"][-1] == pytest.approx(best.summary["clamp"]["ramp_end_s"])
     assert isinstance(best.plot(tmp_path / "p.png"), Figure) and (tmp_path / "p.png").exists()
 
 

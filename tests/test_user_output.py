@@ -77,7 +77,8 @@ def test_two_simulate_runs_into_one_folder_never_mix(tmp_path):
     env = dict(os.environ, PYTHONPATH=str(REPO))
     out = str(tmp_path / "same")
     runs = [subprocess.Popen([sys.executable, "-m", "clutchocp.cli", "simulate", "zhang2021", "--out", out,
-                              "--set", f"oil.viscosity={mu}"], env=env, cwd=REPO, stdout=subprocess.PIPE,
+                              "--set", f"oil.viscosity={mu}", "--set", "driveline.input_speed='1000 rpm'"],
+                             env=env, cwd=REPO, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True) for mu in (0.03, 0.05)]
     results = [(p.wait(timeout=120), p.stderr.read()) for p in runs]
     codes = sorted(code for code, _ in results)

@@ -69,7 +69,8 @@ class OptimizationResult:
         """
         from ..output import save_figure
         from .report import pressure_figure
-        fig = pressure_figure(self.scene, self.optimum, self.replay, self.ocp.baseline, self.summary, self.curve)
+        fig = pressure_figure(self.scene, self.optimum, self.replay, self.ocp.baseline, self.summary, self.curve,
+                              self.clamp_run)
         if path is not None:
             save_figure(fig, path)
         return fig

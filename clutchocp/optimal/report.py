@@ -76,7 +76,8 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     summary, scene, ocp, opt, replay = result.summary, result.scene, result.ocp, result.optimum, result.replay
     out = Path(out_dir)
     files = [_write_profile(out, result), write_summary(out / "summary.json", summary)]
-    files += plot_optimum(out, scene, opt, replay, ocp.baseline, result.baselines, summary, result.curve)
+    files += plot_optimum(out, scene, opt, replay, ocp.baseline, result.baselines, summary, result.curve,
+                          result.clamp_run)
     files.append(plot_heat(replay, out / "heat.png", max_temperature_C=max_temperature_C,
                            max_specific_power_W_mm2=max_specific_power_W_mm2, what="the IDAS replay of the optimum"))
     if ocp.model.has_piston:
@@ -321,12 +322,13 @@ def _slip(run):
     return res.t, (res.t <= t_lock) if t_lock is not None else np.ones(res.t.size, bool)
 
 
-def plot_optimum(out, scene, opt, replay, baseline, baselines, summary, curve=None):
+def plot_optimum(out, scene, opt, replay, baseline, baselines, summary, curve=None, clamp_run=None):
     """Pressure, torque, speeds and jerk of the optimum (IDAS replay) against the baseline; baselines bar chart."""
     files = []
     name = scene.name
     runs = (("optimal (IDAS replay)", replay, "C0"), (f"baseline ({summary['baseline']['profile']})", baseline, "C3"))
-    files.append(save_figure(pressure_figure(scene, opt, replay, baseline, summary, curve), out / "pressure.png"))
+    files.append(save_figure(pressure_figure(scene, opt, replay, baseline, summary, curve, clamp_run),
+                             out / "pressure.png"))
 
     for key, ylabel, fname, title in (("total_torque_Nm", "clutch torque [N m]", "torque.png", "clutch torque"),
                                       ("output_jerk_rad_s3", "output jerk [rad/s^3]", "jerk.png", "output jerk")):
@@ -356,9 +358,10 @@ def plot_optimum(out, scene, opt, replay, baseline, baselines, summary, curve=No
     return files
 
 
-def pressure_figure(scene, opt, replay, baseline, summary, curve=None):
-    """The optimal command (and its continuation after lock-up, ``curve``), its IDAS replay, the
-    collocation points and the baseline's pressure."""
+def pressure_figure(scene, opt, replay, baseline, summary, curve=None, clamp_run=None):
+    """The optimal command (and its continuation after lock-up, ``curve``), its IDAS replay (after
+    lock-up: the replay of the whole curve, ``clamp_run``), the collocation points and the baseline's
+    pressure."""
     runs = (("optimal (IDAS replay)", replay, "C0"), (f"baseline ({summary['baseline']['profile']})", baseline, "C3"))
     fig, (ax,) = new_figure()
     if opt.control == "constant":
@@ -373,7 +376,12 @@ def pressure_figure(scene, opt, replay, baseline, summary, curve=None):
                 color="C2", lw=1.2, ls="--",
                 label=f"command after lock-up: ramp to clamp ({curve.margin:g} x locked torque)")
     for label, run, color in runs:
-        ax.plot(run.result.t, run.result["pressure_Pa"] / 1e6, color=color, label=label)
+        t, p = run.result.t, run.result["pressure_Pa"]
+        if run is replay and clamp_run is not None:       # the curve a user applies, not the check's hold
+            t_lock = run.summary["engagement_time_s"] or t[-1]
+            t = np.concatenate([t[t <= t_lock], clamp_run.result.t[clamp_run.result.t > t_lock]])
+            p = np.concatenate([p[run.result.t <= t_lock], clamp_run.result["pressure_Pa"][clamp_run.result.t > t_lock]])
+        ax.plot(t, p / 1e6, color=color, label=label)
     ax.plot(opt.t, opt.outputs["pressure_Pa"] / 1e6, ".", color="C0", ms=2, label="collocation")
     ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{scene.name}: engagement pressure")
     _locks(ax, runs)

@@ -382,7 +382,7 @@ class RobustOCP:
         else:
             t_guess = guess.lock_times
         lock_intervals = np.clip(np.ceil(t_guess / h_c - 1e-9).astype(int) - 1, 0, self.intervals - 1)
-        result = None
+        result, converged, previous_moves = None, None, np.zeros(len(lock_intervals), int)
         for _ in range(max_shifts + 1):
             nlp = self.nlp(ocp, aggregate, t_max, lock_intervals)
             warm = result is None and guess is not None and guess.w.size == nlp.lbx.size \
@@ -390,12 +390,20 @@ class RobustOCP:
             result = self._solve_stage(ocp, nlp, t_max, weights, aggregate, omega, guess if warm else None,
                                        result or guess, warm)
             stages.append(dict(result.stats, model=label))
+            if result.success:
+                converged = result
+            elif converged is not None:
+                # A move made the problem fail: keep the last converged solution (its lock-up on the
+                # bound of its interval is an optimum of the problem with that interval).
+                return converged
             # A lock-up interval no command meets shows as a local infeasibility, with the lock-up
             # of the scenario at fault on a bound of its interval: move it there and solve again.
             last = result
             moves = nlp.interval_moves(result.w, result.lam_x, stuck=not result.success)
+            moves[moves == -previous_moves] = 0           # no move back: that oscillates between two intervals
             if not np.any(moves):
                 break
+            previous_moves = moves
             lock_intervals = lock_intervals + moves
             if not result.success:
                 result = None

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from clutchocp.engagement.run import simulate_engagement
+from clutchocp.errors import ClutchocpError
 from clutchocp.optimal import EngagementOCP
 from clutchocp.optimal.robust import RobustOCP
 from clutchocp.optimal.replay import CommandModel, simulate_command
@@ -163,7 +164,12 @@ def main():
     report = {"timing": []}
     print(f"{'scenarios':>9s} {'build [s]':>10s} {'solve [s]':>10s} {'iterations':>10s} {'re-solves':>9s}")
     for count in args.scenarios:
-        _, result, build, total = solve(scene, scenario_set(scene, count), args.intervals, args.jump_weight)
+        try:
+            _, result, build, total = solve(scene, scenario_set(scene, count), args.intervals, args.jump_weight)
+        except ClutchocpError as exc:
+            report["timing"].append({"scenarios": count, "failed": str(exc)})
+            print(f"{count:9d} failed: {exc}", flush=True)
+            continue
         row = {"scenarios": count, "build_s": build, "solve_s": total, "iterations": result.stats["iterations"],
                "solves": len(result.stats["stages"]), "objective": result.objective}
         report["timing"].append(row)

@@ -78,7 +78,7 @@ def test_worst_of_one_scenario_is_the_nominal_problem(scene, nominal):
 @pytest.fixture(scope="module")
 def spread(scene):
     mu = scene.value("friction.mu")
-    problem = RobustOCP(scene, [{"friction.mu": 0.95 * mu}, {"friction.mu": 1.05 * mu}], intervals=N,
+    problem = RobustOCP(scene, [{"friction.mu": 0.95 * mu}, {"friction.mu": 1.05 * mu}], intervals=12,
                         jump="penalty", polish=False)
     weights = {"jump": 30.0}
     return problem, problem.solve(weights=weights), problem.solve(weights=weights, aggregate="worst")

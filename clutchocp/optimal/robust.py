@@ -53,6 +53,7 @@ import casadi as ca
 import numpy as np
 
 from ..engagement.model import EngagementModel
+from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
 from .collocation import _repeat_columns, _sparse
 from .derivatives import IPOPT_OPTIONS, WARM_OPTIONS
@@ -62,6 +63,7 @@ from .replay import simulate_command
 
 AGGREGATES = ("mean", "worst")
 PRESOLVE_INTERVALS = 10
+STARTS = ("ramp", "baseline")      # start points tried in turn (see RobustOCP.start_runs)
 
 
 class ParametricScene:
@@ -246,6 +248,7 @@ class RobustOCP:
         self._nlps = {}
         self._solvers = {}
         self._fastest = None
+        self._start = STARTS[0]
 
     @property
     def n_scenarios(self):
@@ -343,11 +346,19 @@ class RobustOCP:
             coarse = RobustOCP(self.scene, self.overrides, intervals=presolve_intervals,
                                **dict(self._ocp_options, polish=False, baseline=ocp.baseline))
             coarse._fastest = fastest
-            start = coarse._solve_model(coarse.ocp, t_max, weights, aggregate, omega, None, max_shifts, stages,
-                                        f"smooth, {presolve_intervals} intervals")
+            for kind in STARTS:
+                coarse._start = kind
+                start = coarse._solve_model(coarse.ocp, t_max, weights, aggregate, omega, None, max_shifts, stages,
+                                            f"smooth, {presolve_intervals} intervals, start {kind}")
+                if start.success:
+                    break
             if not start.success:
                 start = None
-        result = self._solve_model(ocp, t_max, weights, aggregate, omega, start, max_shifts, stages, "smooth")
+        for kind in STARTS:
+            self._start = kind
+            result = self._solve_model(ocp, t_max, weights, aggregate, omega, start, max_shifts, stages, "smooth")
+            if result.success or start is not None:
+                break
         if ocp.polish and result.success:
             polished = self._solve_model(ocp.exact, t_max, weights, aggregate, omega, result, max_shifts, stages,
                                          "exact")
@@ -372,7 +383,7 @@ class RobustOCP:
         else:
             t_guess = guess.lock_times
         lock_intervals = np.clip(np.ceil(t_guess / h_c - 1e-9).astype(int) - 1, 0, self.intervals - 1)
-        result = None
+        result, converged, previous_moves = None, None, np.zeros(len(lock_intervals), int)
         for _ in range(max_shifts + 1):
             nlp = self.nlp(ocp, aggregate, t_max, lock_intervals)
             warm = result is None and guess is not None and guess.w.size == nlp.lbx.size \
@@ -380,32 +391,50 @@ class RobustOCP:
             result = self._solve_stage(ocp, nlp, t_max, weights, aggregate, omega, guess if warm else None,
                                        result or guess, warm)
             stages.append(dict(result.stats, model=label))
+            if result.success:
+                converged = result
+            elif converged is not None:
+                # A move made the problem fail: keep the last converged solution (its lock-up on the
+                # bound of its interval is an optimum of the problem with that interval).
+                return converged
             # A lock-up interval no command meets shows as a local infeasibility, with the lock-up
             # of the scenario at fault on a bound of its interval: move it there and solve again.
             last = result
             moves = nlp.interval_moves(result.w, result.lam_x, stuck=not result.success)
+            moves[moves == -previous_moves] = 0           # no move back: that oscillates between two intervals
             if not np.any(moves):
                 break
+            previous_moves = moves
             lock_intervals = lock_intervals + moves
             if not result.success:
                 result = None
         return result if result is not None else last
 
     def start_runs(self, t_max):
-        """IDAS runs of every scenario under the start command: a ramp over the first command step
-        to the pressure limit, then held (cached per t_max).
+        """IDAS runs of every scenario under the start command (cached per t_max and start).
 
-        The grid represents that command exactly, so the lock-up intervals it gives can be met:
-        the start is feasible. (Starting from the scenarios' own baseline runs put a fast and a
-        slow corner into the same last interval, which no command meets: measured, IPOPT reported
-        the 9-point box infeasible; a step at t = 0, which the rate limit on the grid does not
-        allow, gave lock-ups the grid cannot reach as soon.) Re-solves then move the lock-ups later.
+        Start "baseline": the scene's own pressure profile (its baseline; the command guess is the
+        nominal baseline's). Start "ramp": a ramp over the first command step to the pressure limit,
+        then held. The grid represents the ramp exactly, so the lock-up intervals it gives can be
+        met; the baseline may leave a slow scenario unlocked by t_max, and then the intervals put a
+        fast and a slow corner into the same last interval, which no command meets (measured: the
+        9-point box infeasible from the baseline; two scenarios 5 % apart in mu on 10 command steps
+        converged from the baseline but not from the ramp within 500 iterations; the 9-point box on
+        20 steps converged from the ramp and not with the baseline tried first). :meth:`solve` tries
+        the ramp first and the baseline if that fails. Re-solves then move the lock-ups.
         """
-        key = float(t_max)
+        key = (float(t_max), self._start)
         if getattr(self, "_start_key", None) != key:
             h_c = t_max / self.intervals
-            times, values = [0.0, h_c], [self.ocp.scene.value("actuation.initial_pressure"), self.ocp.p_max]
-            self._start_runs = [simulate_command(s, times, values, 2.0 * t_max, control="linear") for s in self.scenes]
+            if self._start == "ramp":
+                times, values = [0.0, h_c], [self.ocp.scene.value("actuation.initial_pressure"), self.ocp.p_max]
+                self._start_runs = [simulate_command(s, times, values, 2.0 * t_max, control="linear")
+                                    for s in self.scenes]
+            else:
+                self._start_runs = [simulate_engagement(s) for s in self.scenes]
+                base = self.ocp.nlp.unpack(guess_from_run(self.ocp, self.ocp.reference_run, t_max=t_max))
+                times = self.ocp.transcription.node_times(base["T"])[0] * self.ocp.scales.time_s
+                values = base["u"][:, 0] * self.ocp.scales.pressure_Pa
             self._start_key = key
             self._start_command = (times, values)
         return self._start_runs

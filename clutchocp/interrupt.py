@@ -9,6 +9,12 @@ places that call the solvers ask :func:`check` afterwards (between integrator ca
 IPOPT solve, before an output folder is put in place). IPOPT gets an iteration callback
 (:func:`ipopt_callback`) that stops it at the next iteration once the flag is set.
 
+Inside a solver call (:func:`in_solver`) the handler only sets the flag: CasADi polls Python's
+signal handlers during its evaluations, and an exception raised there is reported on stderr as a
+failed evaluation ("res failed: KeyboardInterrupt", "the residual function failed unrecoverably")
+before the run could say one line. The call finishes its current piece (an IDAS call between two
+events, an IPOPT iteration) and the caller's :func:`check` stops the run.
+
 Without :func:`catch_interrupts` (a library user's own program) the flag is never set and
 nothing changes.
 """
@@ -17,7 +23,7 @@ import signal
 import threading
 from contextlib import contextmanager
 
-_state = {"requested": False}
+_state = {"requested": False, "solver_depth": 0}
 
 
 class UserInterrupt(KeyboardInterrupt):
@@ -43,7 +49,19 @@ def check(where=""):
 
 def _handler(signum, frame):
     _state["requested"] = True
-    raise UserInterrupt("interrupted by the user")
+    if not _state["solver_depth"]:
+        raise UserInterrupt("interrupted by the user")
+
+
+@contextmanager
+def in_solver():
+    """Around a CasADi solver call: a Ctrl-C only sets the flag (see the module notes); call
+    :func:`check` after the block."""
+    _state["solver_depth"] += 1
+    try:
+        yield
+    finally:
+        _state["solver_depth"] -= 1
 
 
 @contextmanager

@@ -656,7 +656,8 @@ class EngagementOCP:
         p = [weights[k] for k in OBJECTIVE_TERMS]
         solver = self.solver(warm)
         start = time.perf_counter()
-        sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p)
+        with interrupt.in_solver():
+            sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p)
         wall = time.perf_counter() - start
         interrupt.check(f"IPOPT (scene '{self.scene.name}', t_max = {t_max:.4g} s)")
         st = solver.stats()

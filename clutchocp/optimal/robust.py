@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from .. import interrupt
 from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
@@ -285,7 +286,9 @@ class RobustOCP:
         if key not in self._solvers:
             options = dict(IPOPT_OPTIONS, **(WARM_OPTIONS if warm else {}))
             self._solvers[key] = ca.nlpsol(f"robust_{'warm' if warm else 'cold'}", "ipopt", nlp.nlp,
-                                           {"print_time": False, "ipopt": options, "error_on_fail": False})
+                                           {"print_time": False, "ipopt": options, "error_on_fail": False,
+                                            # stops IPOPT at the next iteration after a Ctrl-C
+                                            "iteration_callback": interrupt.ipopt_callback()})
         return self._solvers[key]
 
     # -- solving ------------------------------------------------------------------------------
@@ -456,7 +459,10 @@ class RobustOCP:
             w0[nlp.tau_slice.stop:] = np.max(np.array(nlp.objectives_fn(w0, p)))
         solver = self.solver(nlp, warm)
         start = time.perf_counter()
-        sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg, p=p)
+        with interrupt.in_solver():
+            sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg,
+                         p=p)
+        interrupt.check("IPOPT (robust feedforward)")
         wall = time.perf_counter() - start
         st = solver.stats()
         stats = {"status": st["return_status"], "success": bool(st["success"]), "iterations": int(st["iter_count"]),

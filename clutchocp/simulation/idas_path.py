@@ -218,7 +218,8 @@ class IdasPath:
         self.counters["n_integrator_calls"] += 1
         start = time.perf_counter()
         try:
-            xs, zs = entry(x0, z0, p)
+            with interrupt.in_solver():
+                xs, zs = entry(x0, z0, p)
         except RuntimeError as err:
             self._count(entry.stats(), start)
             # a Ctrl-C inside IDAS surfaces as a failed step ("psetup failed: KeyboardInterrupt")

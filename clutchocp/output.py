@@ -95,7 +95,8 @@ class OutputFolder:
         return self.target / Path(file).relative_to(self.path)
 
 
-def _pid_alive(pid):
+def pid_alive(pid):
+    """True if a process ``pid`` runs on this machine (a lock it holds is live)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -115,7 +116,7 @@ def _take_lock(lock, text, field):
                 pid = int(lock.read_text().strip() or 0)
             except (OSError, ValueError):
                 pid = 0
-            if pid and _pid_alive(pid):
+            if pid and pid_alive(pid):
                 raise OutputFolderError(f"{field} {text}: another clutchocp run (process {pid}) is writing this "
                                         "folder; wait for it to finish or give another folder") from None
             lock.unlink(missing_ok=True)          # left behind by a run that was killed

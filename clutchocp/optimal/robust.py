@@ -35,7 +35,7 @@ of the default box), so the robust use is ``jump="penalty"`` with a ``jump`` wei
 every scenario is an objective term.
 
 One dynamics function for all scenarios. The uncertain scene values are symbols of the model
-(:class:`ParametricScene`): :class:`ParametricOCP` builds the scaled dynamics, objective and end
+(:class:`clutchocp.scene.symbolic.SymbolicScene`): :class:`ParametricOCP` builds the scaled dynamics, objective and end
 functions of the nominal problem with a parameter vector theta of those values, and the robust
 NLP evaluates the dynamics at every collocation point of every scenario by one CasADi ``map``
 (theta of the point's scenario as an input), so the cost of the NLP functions grows linearly with
@@ -56,6 +56,7 @@ from .. import interrupt
 from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
+from ..scene.symbolic import SymbolicScene
 from .collocation import _repeat_columns, _sparse
 from .derivatives import IPOPT_OPTIONS, WARM_OPTIONS
 from .guess import guess_from_run
@@ -65,35 +66,6 @@ from .replay import simulate_command
 AGGREGATES = ("mean", "worst")
 PRESOLVE_INTERVALS = 10
 STARTS = ("ramp", "baseline")      # start points tried in turn (see RobustOCP.start_runs)
-
-
-class ParametricScene:
-    """A scene whose named values are CasADi symbols (everything else is the scene's).
-
-    Parameters
-    ----------
-    scene : clutchocp.scene.Scene
-    symbols : dict
-        ``{"part.key": casadi.SX}``.
-    """
-
-    def __init__(self, scene, symbols):
-        self._scene = scene
-        self._symbols = dict(symbols)
-        # The film law's static coefficient defaults to the (constant) friction coefficient at
-        # rest, which it evaluates as a number: give it the symbol instead.
-        if ("friction.mu" in self._symbols and scene.variant("friction") == "constant"
-                and scene.get("friction.static_coefficient") is None):
-            self._symbols["friction.static_coefficient"] = self._symbols["friction.mu"]
-
-    def value(self, name):
-        return self._symbols[name] if name in self._symbols else self._scene.value(name)
-
-    def get(self, name, default=None):
-        return self._symbols[name] if name in self._symbols else self._scene.get(name, default)
-
-    def __getattr__(self, name):
-        return getattr(self._scene, name)
 
 
 class ParametricOCP(EngagementOCP):
@@ -132,7 +104,7 @@ class ParametricOCP(EngagementOCP):
         numeric = self.model
         symbols = dict(zip(self.parameter_names, ca.vertsplit(self.theta)))
         try:
-            self.model = EngagementModel(ParametricScene(self.scene, symbols), smooth=self.smooth,
+            self.model = EngagementModel(SymbolicScene(self.scene, symbols), smooth=self.smooth,
                                          pressure_command=self.u)
             out = super()._build_functions(mode_name, role)
         except (TypeError, RuntimeError, NotImplementedError) as exc:

@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 from ..errors import ClutchocpError
+from ..output import pid_alive
 
 RESULTS = "results.csv"
 CALIBRATION = "calibration.csv"
@@ -54,16 +55,6 @@ def parse_cell(text):
         return float(text)
     except ValueError:
         return text
-
-
-def _pid_alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 class StudyFolder:
@@ -116,7 +107,7 @@ class StudyFolder:
             except FileExistsError:
                 owner = self._lock.read_text(encoding="utf-8", errors="replace").split()
                 pid, host = (int(owner[0]), owner[1]) if len(owner) >= 2 and owner[0].isdigit() else (None, None)
-                if pid is not None and host == socket.gethostname() and not _pid_alive(pid):
+                if pid is not None and host == socket.gethostname() and not pid_alive(pid):
                     self._lock.unlink(missing_ok=True)          # left by a sweep that no longer runs
                     continue
                 who = f"process {pid} on {host}" if pid is not None else "another process"

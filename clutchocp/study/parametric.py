@@ -19,30 +19,13 @@ folded in a different order.
 
 import copy
 
-import casadi as ca
 
 from ..engagement.model import EngagementModel
+from ..scene.symbolic import SymbolicScene
 from ..simulation.model import HybridModel
 
 AGREEMENT = 1e-6        # relative: the first parametric run against the usual run of the same point
 COMPARED = ("engagement_time_s", "peak_torque_Nm", "dissipated_energy_J")
-
-
-class SymbolicScene:
-    """A scene whose ``names`` fields read as CasADi symbols (everything else as the scene's values)."""
-
-    def __init__(self, scene, names):
-        self._scene = scene
-        self.symbols = {name: ca.SX.sym(name) for name in names}
-
-    def value(self, name):
-        return self.symbols[name] if name in self.symbols else self._scene.value(name)
-
-    def get(self, name, default=None):
-        return self.symbols[name] if name in self.symbols else self._scene.get(name, default)
-
-    def __getattr__(self, attr):
-        return getattr(self._scene, attr)
 
 
 class ParametricModel:

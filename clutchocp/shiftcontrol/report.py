@@ -224,7 +224,7 @@ def _progress_bar(total, enabled):
 
 
 def acceptance(stats, centre):
-    """The issue's acceptance checks (JSON-ready): the numbers, their limits and pass/fail."""
+    """The acceptance checks of the shift-control targets (JSON-ready): the numbers, their limits and pass/fail."""
     out = {}
     cl = stats.get("closed_loop")
     if cl is not None:

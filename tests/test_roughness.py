@@ -190,3 +190,18 @@ def test_two_argument_functions_symbolic_equals_numeric(fun):
     for H in (-4.0, -1.0, 0.0, 1.7, 3.5):
         h = H * sigma if fun is not rg.combined_sigma else abs(H) * 1e-6
         assert sx_eval(fun, h, sigma) == pytest.approx(fun(h, sigma), rel=1e-12, abs=1e-15 * sigma)
+
+
+def test_F52_on_an_sx_scalar_is_the_same_expression_built_once():
+    """The cached SX function (inlined at each call) gives the expression of the direct build:
+    the same value, slope and curvature."""
+    roughness = rg
+    h = ca.SX.sym("h")
+    cached = roughness.F52(h)
+    direct = roughness.exp(roughness.log_F52(h))
+    assert roughness._f52_sx() is roughness._f52_sx()                 # built once
+    fns = [ca.Function("f", [h], [e, ca.gradient(e, h), ca.hessian(e, h)[0]]) for e in (cached, direct)]
+    for H in (-8.0, -2.0, 0.0, 0.7, 3.0, 11.0, 14.0):
+        got, want = ([float(v) for v in f(H)] for f in fns)
+        assert got == pytest.approx(want, rel=1e-14, abs=0.0)
+        assert got[0] == pytest.approx(float(roughness.F52(H)), rel=1e-14)

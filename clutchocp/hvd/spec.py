@@ -136,9 +136,17 @@ def load_controller(name_or_path):
     ------
     SceneError subclasses with a one-line message naming the field.
     """
+    return read_spec(name_or_path, parse_controller)
+
+
+def read_spec(name_or_path, parse):
+    """Read a spec file of controllers/ (built-in name or path) and validate it with ``parse``.
+
+    Errors name the file; the returned spec keeps its ``path``.
+    """
     path, raw = read_toml(name_or_path, "controllers", "controller spec")
     try:
-        spec = parse_controller(raw)
+        spec = parse(raw)
     except SceneError as exc:
         raise type(exc)(f"{path.name}: {exc}") from None
     spec.path = path

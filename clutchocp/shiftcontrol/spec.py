@@ -27,9 +27,9 @@ field::
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import MissingParameterError, ParameterTypeError, PhysicalRangeError, SceneError, UnknownKeyError
-from ..hvd.spec import _table
-from ..scene.loader import _suggest, read_toml
+from ..errors import MissingParameterError, ParameterTypeError, PhysicalRangeError, UnknownKeyError
+from ..hvd.spec import _table, read_spec
+from ..scene.loader import _suggest
 
 TYPES = ("slip_lqi",)
 ANTI_WINDUP = ("clamping", "none")
@@ -92,13 +92,7 @@ def load_slip_spec(name_or_path="slip_lqr"):
     ------
     SceneError subclasses with a one-line message naming the file and the field.
     """
-    path, raw = read_toml(name_or_path, "controllers", "controller spec")
-    try:
-        spec = parse_slip_spec(raw)
-    except SceneError as exc:
-        raise type(exc)(f"{path.name}: {exc}") from None
-    spec.path = path
-    return spec
+    return read_spec(name_or_path, parse_slip_spec)
 
 
 def parse_slip_spec(raw):

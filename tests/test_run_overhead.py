@@ -1,0 +1,47 @@
+"""The per-run shortcuts outside the integrator give what the general code gives.
+
+Each shortcut is checked against an independent way to the same number: the interpolating
+polynomial against ``numpy.polyfit``, the located crossing and peak against closed forms.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from clutchocp.simulation.locate import _cubic, _stationary, crossing_time, peak
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 5])
+def test_interpolating_polynomial_equals_numpy_polyfit(n):
+    rng = np.random.default_rng(n)
+    t = np.sort(rng.uniform(0.0, 2.0, 8))
+    y = rng.normal(size=8)
+    idx = np.arange(2, 2 + n)
+    f, coef, t0, scale = _cubic(t, y, idx)
+    reference = np.polyfit((t[idx] - t0) / scale, y[idx], n - 1)
+    assert np.allclose(coef, reference, rtol=1e-10, atol=1e-12)
+    for k in idx:                                   # through the samples
+        assert f(t[k]) == pytest.approx(y[k], abs=1e-12)
+    s = np.linspace(t[idx[0]], t[idx[-1]], 7)
+    assert np.allclose([f(v) for v in s], np.polyval(reference, (s - t0) / scale), rtol=1e-10, atol=1e-12)
+
+
+@pytest.mark.parametrize("coef", [[1.0, -6.0, 9.0, 1.0], [0.0, 2.0, -4.0, 1.0], [1.0, 0.0, 1.0, 0.0],
+                                  [3.0, -2.0, 1.0], [0.5, -1.0, -3.0, 2.0, 1.0]])
+def test_stationary_points_equal_the_roots_of_the_derivative(coef):
+    roots = np.roots(np.polyder(np.trim_zeros(np.array(coef), "f")))
+    reference = sorted(roots[np.isreal(roots)].real)
+    assert np.allclose(sorted(_stationary(np.array(coef))), reference, rtol=1e-12, atol=1e-12)
+
+
+def test_crossing_and_peak_of_a_cubic_are_exact():
+    """A cubic is reproduced exactly by the local polynomial: the crossing and the peak are its own."""
+    t = np.linspace(0.0, 1.0, 11)
+    y = -(t - 0.1) * (t - 0.5) * (t - 1.3)
+    t_peak = (3.8 + math.sqrt(3.8**2 - 12 * 0.83)) / 6     # y' = -(3 t^2 - 3.8 t + 0.83) = 0, the maximum
+    value, at = peak(t, y)
+    assert at == pytest.approx(t_peak, abs=1e-12)
+    assert value == pytest.approx(-(t_peak - 0.1) * (t_peak - 0.5) * (t_peak - 1.3), abs=1e-13)
+    assert crossing_time(t, t**3, 0.2) == pytest.approx(0.2 ** (1 / 3), abs=1e-12)
+    assert crossing_time(t, t**3, 2.0) is None

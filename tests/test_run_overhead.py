@@ -45,3 +45,23 @@ def test_crossing_and_peak_of_a_cubic_are_exact():
     assert value == pytest.approx(-(t_peak - 0.1) * (t_peak - 0.5) * (t_peak - 1.3), abs=1e-13)
     assert crossing_time(t, t**3, 0.2) == pytest.approx(0.2 ** (1 / 3), abs=1e-12)
     assert crossing_time(t, t**3, 2.0) is None
+
+
+def test_column_function_on_padded_maps_equals_one_call_per_sample():
+    """Maps come in powers of two with the last sample repeated: each column is still the function
+    of its own sample, and a few maps serve every sample count."""
+    import casadi as ca
+
+    from clutchocp.simulation.compiled import ColumnFunction
+
+    xs, zs, pu, t = ca.SX.sym("xs", 2), ca.SX.sym("zs", 1), ca.SX.sym("pu", 2), ca.SX.sym("t")
+    f = ca.Function("f", [xs, zs, pu, t], [ca.vertcat(xs[0] * ca.sin(t) + pu[0], zs[0] / (1 + xs[1] ** 2) - pu[1] * t)])
+    column = ColumnFunction(f)
+    rng = np.random.default_rng(3)
+    p = np.array([0.3, -1.2])
+    for n in (1, 3, 5, 17, 100):
+        X, Z, T = rng.normal(size=(2, n)), rng.normal(size=(1, n)), rng.uniform(0, 1, n)
+        reference = np.column_stack([np.array(f(X[:, k], Z[:, k], p, T[k])).ravel() for k in range(n)])
+        assert np.array_equal(column(X, Z, p, T), reference)
+    assert sorted(column._maps) == [1, 4, 8, 32, 128]
+    assert column(np.zeros((2, 0)), np.zeros((1, 0)), p, np.zeros(0)).shape == (2, 0)

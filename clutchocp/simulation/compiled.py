@@ -43,6 +43,16 @@ def _function(name, inputs, outputs, what, mode):
                          "its states, its algebraic variables, the model parameters, inputs nor time") from None
 
 
+def _padded(a, rows, n, m):
+    """Samples ``a`` (rows, n) as a C-ordered (m, rows) array, the last sample repeated to ``m >= n``."""
+    a = np.reshape(np.asarray(a, float), (rows, n))
+    out = np.empty((m, rows))
+    out[:n] = a.T
+    if m > n and rows:
+        out[n:] = a[:, -1]
+    return out
+
+
 class ColumnFunction:
     """A Function of ``(xs, zs, pu, t)`` evaluated on many samples at once.
 
@@ -91,17 +101,21 @@ class ColumnFunction:
                 self._numpy([np.reshape(np.asarray(xs, float), (nx, n)), np.reshape(np.asarray(zs, float), (nz, n)),
                              np.ravel(np.asarray(pu, float)), t[None, :]], [out])
             return out
-        _, buf, evaluate = self._map(n)
-        args = [np.ascontiguousarray(np.reshape(np.asarray(xs, float), (nx, n)).T),
-                np.ascontiguousarray(np.reshape(np.asarray(zs, float), (nz, n)).T),
-                np.ascontiguousarray(np.ravel(np.asarray(pu, float))), t.copy()]
-        out = np.zeros((n, self.n_out))
+        if n == 0:
+            return np.zeros((self.n_out, 0))
+        # maps come in powers of two (the last column repeated as padding): a run's many
+        # different sample counts share a few cached maps instead of building one each
+        m = 1 << (n - 1).bit_length()
+        _, buf, evaluate = self._map(m)
+        args = [_padded(xs, nx, n, m), _padded(zs, nz, n, m), np.ascontiguousarray(np.ravel(np.asarray(pu, float))),
+                _padded(t, 1, n, m)]
+        out = np.empty((m, self.n_out))
         dummy = np.zeros(1)
         for i, a in enumerate(args):
             buf.set_arg(i, memoryview(a if a.size else dummy))
         buf.set_res(0, memoryview(out if out.size else dummy))
         evaluate()
-        return out.T
+        return out[:n].T
 
 
 class CompiledMode:

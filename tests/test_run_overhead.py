@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from clutchocp.simulation.locate import _cubic, _stationary, crossing_time, peak
+from clutchocp.simulation.locate import _cubic, _cubic_roots, _stationary, crossing_time, peak
 
 
 @pytest.mark.parametrize("n", [2, 3, 4, 5])
@@ -33,6 +33,18 @@ def test_stationary_points_equal_the_roots_of_the_derivative(coef):
     roots = np.roots(np.polyder(np.trim_zeros(np.array(coef), "f")))
     reference = sorted(roots[np.isreal(roots)].real)
     assert np.allclose(sorted(_stationary(np.array(coef))), reference, rtol=1e-12, atol=1e-12)
+
+
+def test_real_roots_of_a_cubic_equal_numpy_roots():
+    rng = np.random.default_rng(7)
+    cases = [rng.normal(size=4) for _ in range(200)] + [[1.0, -6.0, 11.0, -6.0], [1.0, 0.0, 0.0, -8.0],
+                                                        [2.0, -3.0, 0.0, 1.0 + 1e-9], [1.0, 0.0, 1.0, 0.0]]
+    for coef in cases:
+        roots = np.roots(coef)
+        real = sorted(roots[np.abs(roots.imag) <= 1e-7 * (1 + np.abs(roots))].real)
+        found = sorted(_cubic_roots(*coef))
+        assert len(found) == len(real), (coef, found, real)
+        assert np.allclose(found, real, rtol=1e-9, atol=1e-9), (coef, found, real)
 
 
 def test_crossing_and_peak_of_a_cubic_are_exact():

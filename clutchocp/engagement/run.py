@@ -207,11 +207,19 @@ def _first_crossing(t, y, level, piece=None):
 def pressure_rise_time(model, result, fraction):
     """First time [s] the pressure has risen by ``fraction`` of the way to the set pressure (located on
     the local cubic of the samples), or None."""
+    return pressure_rise_times(model, result, (fraction,))[fraction]
+
+
+def pressure_rise_times(model, result, fractions, piece=None):
+    """:func:`pressure_rise_time` of each of ``fractions`` (a dict ``{fraction: time [s] or None}``),
+    the pressure samples read once; ``piece``: :func:`pieces` of ``result`` if already at hand."""
     p_set = model.scene.value("actuation.pressure")
     p0 = model.scene.value("actuation.initial_pressure")
     if p_set == p0:
-        return None
-    return _first_crossing(result.t, (result["pressure_Pa"] - p0) / (p_set - p0), fraction, pieces(result))
+        return dict.fromkeys(fractions)
+    rise = (result["pressure_Pa"] - p0) / (p_set - p0)
+    piece = pieces(result) if piece is None else piece
+    return {fraction: _first_crossing(result.t, rise, fraction, piece) for fraction in fractions}
 
 
 def _slipping(result):
@@ -219,28 +227,32 @@ def _slipping(result):
     return np.concatenate([np.full(seg.t.size, not str(seg.mode).endswith("locked")) for seg in result.segments])
 
 
-def response_times(model, result):
+def response_times(model, result, *, rise=None, piece=None, slipping=None):
     """Zhang 2021's response times [s], with the torque response measured to the largest slipping torque.
 
     Pressure response: from 10 % to 90 % of the set pressure. Torque response (peak-based): from
     50 % of the set pressure to 90 % of the largest slipping torque (viscous + asperity). Zhang's
-    own definition, to the stable torque, is :func:`stable_torque_response`.
+    own definition, to the stable torque, is :func:`stable_torque_response`. ``rise``
+    (:func:`pressure_rise_times` of 0.1, 0.5 and 0.9), ``piece`` (:func:`pieces`) and ``slipping``
+    save reading them again when the caller has them.
     """
-    t, piece = result.t, pieces(result)
-    t10, t50, t90 = (pressure_rise_time(model, result, frac) for frac in (0.1, 0.5, 0.9))
+    t = result.t
+    piece = pieces(result) if piece is None else piece
+    rise = pressure_rise_times(model, result, (0.1, 0.5, 0.9), piece) if rise is None else rise
+    t10, t50, t90 = rise[0.1], rise[0.5], rise[0.9]
     pressure_time = t90 - t10 if t10 is not None and t90 is not None else None
-    slipping = _slipping(result)
-    torque = np.abs(result["total_torque_Nm"])
+    slipping = _slipping(result) if slipping is None else slipping
     torque_time = None
     if t50 is not None and slipping.any():
-        t90_torque = _first_crossing(t[slipping], torque[slipping],
-                                     0.9 * peak(t[slipping], torque[slipping], piece[slipping])[0], piece[slipping])
+        t_slip, piece_slip = t[slipping], piece[slipping]
+        torque = np.abs(result["total_torque_Nm"][slipping])
+        t90_torque = _first_crossing(t_slip, torque, 0.9 * peak(t_slip, torque, piece_slip)[0], piece_slip)
         if t90_torque is not None:
             torque_time = t90_torque - t50
     return pressure_time, torque_time
 
 
-def stable_torque_response(model, result):
+def stable_torque_response(model, result, *, t50=False, piece=None, slipping=None):
     """Zhang 2021's torque response to the stable transmitted torque (Zhang Section 3, Fig. 2).
 
     Zhang defines the torque response time as the time from 50 % of the set pressure to the
@@ -252,21 +264,24 @@ def stable_torque_response(model, result):
     torque reaches 90 % of it. The total torque is not used: its viscous part can exceed the
     stable torque from the start of the squeeze (zhang2021 at 1000 rad/s: 43 N m on the open gap
     against 53 N m stable), which would make the time negative and blind to the contact.
+    ``t50`` (the 50 % pressure time, None if never), ``piece`` and ``slipping`` save reading them
+    again when the caller has them.
 
     Returns
     -------
     (stable_torque, response_time) : [N m], [s]; each None if it does not exist (no slip, no
     asperity torque, or the pressure never reaches 50 %).
     """
-    slipping = _slipping(result)
+    slipping = _slipping(result) if slipping is None else slipping
     if not slipping.any():
         return None, None
     t, contact_torque = result.t[slipping], np.abs(result["contact_torque_Nm"][slipping])
     stable = float(contact_torque[-1])
-    t50 = pressure_rise_time(model, result, 0.5)
+    piece = pieces(result) if piece is None else piece
+    t50 = pressure_rise_times(model, result, (0.5,), piece)[0.5] if t50 is False else t50
     if stable <= 0 or t50 is None:
         return (stable if stable > 0 else None), None
-    t90 = _first_crossing(t, contact_torque, 0.9 * stable, pieces(result)[slipping])
+    t90 = _first_crossing(t, contact_torque, 0.9 * stable, piece[slipping])
     return stable, (t90 - t50 if t90 is not None else None)
 
 
@@ -310,14 +325,17 @@ def summarize(model, result, wall_time, options, method):
     elif all(str(seg.mode).endswith("locked") for seg in result.segments):
         t_lock = float(result.t[0])          # locked from the start (equal speeds held): no slip, no jump
     energy = energy_balance(model, result)
-    pressure_time, torque_time = response_times(model, result)
-    stable_torque, stable_torque_time = stable_torque_response(model, result)
+    piece, slipping = pieces(result), _slipping(result)
+    rise = pressure_rise_times(model, result, (0.1, 0.5, 0.9), piece)
+    pressure_time, torque_time = response_times(model, result, rise=rise, piece=piece, slipping=slipping)
+    stable_torque, stable_torque_time = stable_torque_response(model, result, t50=rise[0.5], piece=piece,
+                                                               slipping=slipping)
     jerk = result["output_jerk_rad_s3"]
     summary = {
         "scene": model.scene.name,
         "engagement_time_s": t_lock,
         "lockup_torque_jump_Nm": jump,
-        "peak_torque_Nm": peak(result.t, np.abs(result["total_torque_Nm"]), pieces(result))[0],
+        "peak_torque_Nm": peak(result.t, np.abs(result["total_torque_Nm"]), piece)[0],
         "peak_jerk_rad_s3": float(np.max(np.abs(jerk[np.isfinite(jerk)]))),
         "dissipated_energy_J": energy["dissipated_J"],
         "energy_balance_rel_error": energy["rel_error"],

@@ -44,7 +44,7 @@ def _cubic(t, y, idx):
     -------
     f : callable
         ``f(time)`` [s] -> the polynomial's value.
-    coef : ndarray
+    coef : list of float
         Coefficients in ``s``, highest power first.
     t0, scale : float
         The local variable is ``s = (time - t0) / scale``.
@@ -68,24 +68,24 @@ def _cubic(t, y, idx):
             value = value * u + a
         return value
 
-    return f, np.array(coef), t0, scale
+    return f, coef, t0, scale
 
 
 def _sign(v):
+    v = float(v)
     return (v > 0) - (v < 0)
 
 
 def _stationary(coef):
     """Real roots of the derivative of the polynomial ``coef`` (highest power first); closed form up
     to a quadratic derivative."""
-    d = [(len(coef) - 1 - i) * a for i, a in enumerate(coef[:-1])]     # derivative, highest first
+    d = [(len(coef) - 1 - i) * float(a) for i, a in enumerate(coef[:-1])]     # derivative, highest first
     while d and d[0] == 0:
         d = d[1:]
     if len(d) == 2:
         return [-d[1] / d[0]]
-    if len(d) > 3:                              # five samples: a quartic's cubic derivative
-        roots = np.roots(d)
-        return list(roots[np.isreal(roots)].real)
+    if len(d) == 4:                             # five samples: a quartic's cubic derivative
+        return _cubic_roots(*d)
     if len(d) != 3:
         return []
     a, b, c = d
@@ -94,6 +94,33 @@ def _stationary(coef):
         return []
     q = -0.5 * (b + math.copysign(math.sqrt(disc), b))
     return [q / a] + ([c / q] if q != 0 else [])
+
+
+def _cubic_roots(a, b, c, d):
+    """Real roots of ``a x^3 + b x^2 + c x + d`` (``a != 0``): the trigonometric form for three real
+    roots, Cardano's for one, each polished by two Newton steps (tested against ``numpy.roots``)."""
+    b, c, d = b / a, c / a, d / a
+    p = c - b * b / 3.0                          # depressed cubic y^3 + p y + q, x = y - b/3
+    q = 2.0 * b**3 / 27.0 - b * c / 3.0 + d
+    disc = (q / 2.0) ** 2 + (p / 3.0) ** 3
+    if disc < 0:                                 # three real roots (p < 0)
+        r = 2.0 * math.sqrt(-p / 3.0)
+        phi = math.acos(max(-1.0, min(1.0, 3.0 * q / (p * r))))
+        ys = [r * math.cos((phi - 2.0 * math.pi * k) / 3.0) for k in range(3)]
+    else:
+        w = math.sqrt(disc)
+        u, v = -q / 2.0 + w, -q / 2.0 - w
+        ys = [math.copysign(abs(u) ** (1 / 3), u) + math.copysign(abs(v) ** (1 / 3), v)]
+    roots = []
+    for y in ys:
+        x = y - b / 3.0
+        for _ in range(2):
+            slope = (3.0 * x + 2.0 * b) * x + c
+            if slope == 0:
+                break
+            x -= (((x + b) * x + c) * x + d) / slope
+        roots.append(x)
+    return roots
 
 
 def crossing_time(t, y, level, piece=None, start=0):
@@ -151,9 +178,10 @@ def peak(t, y, piece=None):
         if idx.size < 3:
             continue
         f, coef, t0, scale = _cubic(t, y, idx)
+        lo, hi = float(t[a]), float(t[a + 1])
         for r in _stationary(coef):
             s = t0 + r * scale
-            if t[a] < s < t[a + 1] and f(s) > best[0]:
+            if lo < s < hi and f(s) > best[0]:
                 best = (float(f(s)), float(s))
     return best
 

@@ -77,3 +77,24 @@ def test_column_function_on_padded_maps_equals_one_call_per_sample():
         assert np.array_equal(column(X, Z, p, T), reference)
     assert sorted(column._maps) == [1, 4, 8, 32, 128]
     assert column(np.zeros((2, 0)), np.zeros((1, 0)), p, np.zeros(0)).shape == (2, 0)
+
+
+def test_scalar_calls_of_the_numpy_translation_share_padded_maps():
+    """An interpolant called on n samples runs on a map of the next power of two (the last sample
+    repeated): the values equal CasADi's sample by sample, and 40 to 64 samples share one map."""
+    import casadi as ca
+
+    from clutchocp.physics.roughness import log_F52
+    from clutchocp.simulation import vectorized
+
+    h = ca.SX.sym("h")
+    f = ca.Function("f", [h], [log_F52(h)])
+    table = next(f.instructions_sx()[k].which_function() for k in range(f.n_instructions())
+                 if f.instruction_id(k) == ca.OP_CALL)
+    for n in (40, 51, 64):
+        x = np.linspace(0.5, 3.0, n)
+        got = vectorized._call(table, x)
+        assert got.shape == (n,)
+        assert np.array_equal(got, [float(table(v)) for v in x])
+    assert [m for (name, m) in vectorized._MAPS if name == table.name()] == [64]
+    assert vectorized._call(table, 1.5) == float(table(1.5))

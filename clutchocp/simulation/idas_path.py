@@ -221,16 +221,18 @@ class IdasPath:
             with interrupt.in_solver():
                 xs, zs = entry(x0, z0, p)
         except RuntimeError as err:
-            self._count(entry.stats(), start)
+            self._count(entry, start)
             # a Ctrl-C inside IDAS surfaces as a failed step ("psetup failed: KeyboardInterrupt")
             interrupt.check(f"{self.name.upper()} at t = {p[-2]:.6g} s")
             raise _IdasFailure(idas_flag(err), str(err)) from None
-        self._count(entry.stats(), start)
+        self._count(entry, start)
         interrupt.check(f"{self.name.upper()} at t = {p[-2]:.6g} s")
         return xs, zs
 
-    def _count(self, stats, start):
+    def _count(self, entry, start):
+        """Add the time since ``start`` (the integrator call alone) and the call's statistics."""
         self.counters["integration_time_s"] += time.perf_counter() - start
+        stats = entry.stats()
         for key, name in _COUNTERS.items():
             self.counters[name] += int(stats.get(key, 0))
 

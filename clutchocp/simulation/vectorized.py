@@ -63,7 +63,7 @@ def _scalar_call(callee, ins, outs):
             and all(callee.numel_in(i) == 1 for i in range(callee.n_in())))
 
 
-_MAPS = {}              # (callee name, n) -> (map of callee over n samples, its buffer, evaluate)
+_MAPS = {}              # (callee name, m) -> (callee, its map over m samples, the map's buffer, evaluate)
 _MAX_MAPS = 256
 _DUMMY = np.zeros(1)
 
@@ -73,21 +73,32 @@ def _call(callee, *args):
     through a map over the samples called with the buffer interface (numpy in and out)."""
     shape = np.broadcast(*args).shape
     n = int(np.prod(shape)) if shape else 1
-    key = (callee.name(), n)
+    if n == 0:
+        return np.zeros(shape)
+    m = 1 << (n - 1).bit_length()          # maps in powers of two, the last sample repeated: few maps
+    key = (callee.name(), m)                # serve every sample count
     entry = _MAPS.get(key)
     if entry is None or entry[0] is not callee:
         if len(_MAPS) >= _MAX_MAPS:
             _MAPS.pop(next(iter(_MAPS)))
-        mapped = callee.map(n)
+        mapped = callee.map(m)
         entry = _MAPS[key] = (callee, mapped, *mapped.buffer())
     _, _, buffer, evaluate = entry
-    values = iter([np.ascontiguousarray(np.broadcast_to(a, shape), dtype=float).ravel() for a in args])
+    values = iter([_pad(np.broadcast_to(a, shape), n, m) for a in args])
     for i in range(callee.n_in()):
         buffer.set_arg(i, memoryview(next(values) if callee.nnz_in(i) else _DUMMY))
-    result = np.empty(n)
+    result = np.empty(m)
     buffer.set_res(0, memoryview(result))
     evaluate()
-    return result.reshape(shape) if shape else float(result[0])
+    return result[:n].reshape(shape) if shape else float(result[0])
+
+
+def _pad(a, n, m):
+    """The ``n`` values of ``a`` as a flat float array of length ``m >= n``, the last value repeated."""
+    out = np.empty(m)
+    out[:n] = np.ravel(a)
+    out[n:] = out[n - 1]
+    return out
 
 
 def numpy_function(function):

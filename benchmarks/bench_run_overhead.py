@@ -1,0 +1,152 @@
+"""Benchmark (not a test): the share of a sweep point's time spent outside the integrator calls, per
+engagement scene, for this source tree and, side by side in the same run, for another one.
+
+    PYTHONPATH=. python benchmarks/bench_run_overhead.py                         # this tree
+    git archive <commit> | tar -x -C /tmp/base                                   # a tree to compare with
+    PYTHONPATH=. python benchmarks/bench_run_overhead.py --against /tmp/base     # both, interleaved
+
+A point runs as a sweep runs it (:func:`clutchocp.study.tasks.simulate_point`: the scene with the
+point's oil viscosity, one parametric model per process, on CasADi's virtual machine or as compiled
+C). Its share is ``1 - integration_time_s / run_time_s`` of its row (the definition of
+``benchmarks/bench_sweep.py``), the median over ``--points`` points after ``--warm-up`` points
+(the first builds the model and integrators that later points reuse). Also reported: points per
+second on one core (the inverse of the mean point time), and where a point's time goes (a second
+pass over the same points with timers around the parts: scene with the overrides, integrator
+look-up and construction, event location, outputs on the grid, summary).
+
+Every (scene, engine, tree) measurement is a fresh process; the trees alternate within each scene
+and each pair repeats ``--rounds`` times, so a change of the machine's load hits both alike. The
+load (``os.getloadavg``) is recorded before and after. Numbers go to ``bench_run_overhead.json``
+in ``--out`` and to stdout.
+"""
+
+import argparse
+import functools
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+SCENES = ("zhang2021", "bao2020", "default_driveline")
+TARGET = 0.15
+
+
+def _timers(acc):
+    """Wrap the parts of a point with timers adding into ``acc`` (seconds by label)."""
+    import clutchocp.engagement.run as run
+    import clutchocp.simulation.driver as driver
+    import clutchocp.simulation.idas_path as idas_path
+    import clutchocp.study.tasks as tasks
+
+    def wrap(owner, name, label):
+        inner = getattr(owner, name)
+
+        @functools.wraps(inner)
+        def timed(*args, **kwargs):
+            start = time.perf_counter()
+            try:
+                return inner(*args, **kwargs)
+            finally:
+                acc[label] = acc.get(label, 0.0) + time.perf_counter() - start
+        setattr(owner, name, timed)
+
+    wrap(tasks, "point_scene", "scene with overrides")
+    wrap(idas_path.IdasPath, "_integrator", "integrator look-up and construction")
+    wrap(idas_path.IdasPath, "_locate", "event location (integrator calls included)")
+    wrap(driver._Run, "segments", "outputs on the grid")
+    wrap(run, "summarize", "summary")
+
+
+def worker(scene, native, points, warm_up):
+    """One measurement in this process (this tree): JSON-ready dict."""
+    from clutchocp.scene import load_scene
+    from clutchocp.study.tasks import Task, simulate_point
+
+    nominal = load_scene(scene).value("oil.viscosity")
+    task = Task(scene, "simulate", options={"native": "auto" if native else False})
+    n = warm_up + points
+    values = [nominal * (0.95 + 0.1 * k / (n - 1)) for k in range(n)]
+    rows = [simulate_point(task, {"oil.viscosity": v})[0] for v in values]
+    bad = [r for r in rows if r["status"] != "ok" or not r["model_reused"]]
+    if bad:
+        raise RuntimeError(f"{scene}: {len(bad)} points failed or did not reuse the model: {bad[0]}")
+    timed = rows[warm_up:]
+    run = [r["run_time_s"] for r in timed]
+    integ = [r["integration_time_s"] for r in timed]
+    acc = {}
+    _timers(acc)
+    start = time.perf_counter()
+    for a, b in zip(values[warm_up - 1:], values[warm_up:]):  # new values: nothing cached from the first pass
+        simulate_point(task, {"oil.viscosity": 0.5 * (a + b)})
+    second = time.perf_counter() - start
+    return {"share": statistics.median(1 - i / r for i, r in zip(integ, run)),
+            "point_ms": 1e3 * statistics.median(run), "integration_ms": 1e3 * statistics.median(integ),
+            "points_per_second": len(run) / sum(run), "native_used": bool(timed[0]["native_code"]),
+            "n_steps": timed[0]["n_steps"],
+            "breakdown_ms": {"point (timed pass)": 1e3 * second / points,
+                             **{k: 1e3 * v / points for k, v in acc.items()}}}
+
+
+def measure(tree, scene, native, points, warm_up):
+    """:func:`worker` in a fresh process on source tree ``tree``."""
+    env = dict(os.environ, PYTHONPATH=str(tree))
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", scene, "--native" if native else "--vm",
+           "--points", str(points), "--warm-up", str(warm_up)]
+    done = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False, cwd=str(tree))
+    if done.returncode != 0:
+        raise RuntimeError(f"{tree} {scene}: {done.stderr.strip().splitlines()[-1:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def load():
+    return [round(v, 2) for v in os.getloadavg()]
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--out", default="out/bench_run_overhead")
+    parser.add_argument("--against", help="another source tree (e.g. an exported earlier commit) to run side by side")
+    parser.add_argument("--points", type=int, default=12, help="timed points per measurement (default 12)")
+    parser.add_argument("--warm-up", type=int, default=3, help="points run first, not timed (default 3)")
+    parser.add_argument("--rounds", type=int, default=2, help="repeats of each measurement (default 2; median)")
+    parser.add_argument("--scenes", default=",".join(SCENES))
+    parser.add_argument("--engines", default="vm,native", help="vm, native or both (native: compiled C)")
+    parser.add_argument("--worker", help=argparse.SUPPRESS)
+    parser.add_argument("--native", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--vm", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.worker:
+        print(json.dumps(worker(args.worker, args.native, args.points, args.warm_up)))
+        return 0
+    here = Path(__file__).resolve().parents[1]
+    trees = {"this": here} | ({"against": Path(args.against).resolve()} if args.against else {})
+    result = {"target_share": TARGET, "points": args.points, "warm_up": args.warm_up, "rounds": args.rounds,
+              "trees": {k: str(v) for k, v in trees.items()}, "load_before": load(), "scenes": {}}
+    for scene in args.scenes.split(","):
+        for engine in args.engines.split(","):
+            runs = {label: [] for label in trees}
+            for _ in range(args.rounds):
+                for label, tree in trees.items():
+                    runs[label].append(measure(tree, scene, engine == "native", args.points, args.warm_up))
+            entry = {}
+            for label, got in runs.items():
+                best = sorted(got, key=lambda m: m["share"])[len(got) // 2]     # the median round
+                entry[label] = {**best, "share_rounds": [m["share"] for m in got]}
+            if "against" in entry:
+                entry["point_time_this_over_against"] = entry["this"]["point_ms"] / entry["against"]["point_ms"]
+            result["scenes"][f"{scene}/{engine}"] = entry
+            print(scene, engine, {k: round(v["share"], 3) for k, v in entry.items() if isinstance(v, dict)},
+                  file=sys.stderr)
+    result["load_after"] = load()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "bench_run_overhead.json").write_text(json.dumps(result, indent=2) + "\n")
+    print(json.dumps(result, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

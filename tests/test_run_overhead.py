@@ -98,3 +98,20 @@ def test_scalar_calls_of_the_numpy_translation_share_padded_maps():
         assert np.array_equal(got, [float(table(v)) for v in x])
     assert [m for (name, m) in vectorized._MAPS if name == table.name()] == [64]
     assert vectorized._call(table, 1.5) == float(table(1.5))
+
+
+def test_compiler_lookup_is_remembered_per_environment(monkeypatch, tmp_path):
+    """The C compiler is looked up once per ($CC, $PATH), so a changed environment is still honoured."""
+    from clutchocp.simulation import native
+
+    found = native.compiler()
+    monkeypatch.setenv("PATH", str(tmp_path))
+    monkeypatch.delenv("CC", raising=False)
+    assert native.compiler() is None
+    fake = tmp_path / "cc"
+    fake.write_text("#!/bin/sh\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("PATH", str(tmp_path) + ":")
+    assert native.compiler() == str(fake)
+    monkeypatch.undo()
+    assert native.compiler() == found

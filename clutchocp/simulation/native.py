@@ -39,12 +39,16 @@ def cache_dir():
     return Path(base) / "clutchocp" / "native"
 
 
+_FOUND = {}             # ($CC, $PATH) -> the compiler found for them (a sweep asks at every point)
+
+
 def compiler():
-    """Path of the C compiler ($CC, else cc or gcc), or None."""
-    for name in (os.environ.get("CC"), "cc", "gcc"):
-        if name and shutil.which(name):
-            return shutil.which(name)
-    return None
+    """Path of the C compiler ($CC, else cc or gcc), or None (looked up once per $CC and $PATH)."""
+    key = (os.environ.get("CC"), os.environ.get("PATH"))
+    if key not in _FOUND:
+        _FOUND[key] = next((shutil.which(name) for name in (key[0], "cc", "gcc") if name and shutil.which(name)),
+                           None)
+    return _FOUND[key]
 
 
 def compile_function(function, with_jacobian=False):

@@ -79,7 +79,7 @@ def test_column_function_on_padded_maps_equals_one_call_per_sample():
     assert column(np.zeros((2, 0)), np.zeros((1, 0)), p, np.zeros(0)).shape == (2, 0)
 
 
-def test_scalar_calls_of_the_numpy_translation_share_padded_maps():
+def test_scalar_calls_of_the_numpy_translation_share_padded_maps(monkeypatch):
     """An interpolant called on n samples runs on a map of the next power of two (the last sample
     repeated): the values equal CasADi's sample by sample, and 40 to 64 samples share one map."""
     import casadi as ca
@@ -91,6 +91,7 @@ def test_scalar_calls_of_the_numpy_translation_share_padded_maps():
     f = ca.Function("f", [h], [log_F52(h)])
     table = next(f.instructions_sx()[k].which_function() for k in range(f.n_instructions())
                  if f.instruction_id(k) == ca.OP_CALL)
+    monkeypatch.setattr(vectorized, "_MAPS", {})          # the maps other tests left behind
     for n in (40, 51, 64):
         x = np.linspace(0.5, 3.0, n)
         got = vectorized._call(table, x)
@@ -115,3 +116,56 @@ def test_compiler_lookup_is_remembered_per_environment(monkeypatch, tmp_path):
     assert native.compiler() == str(fake)
     monkeypatch.undo()
     assert native.compiler() == found
+
+
+@pytest.fixture(scope="module")
+def driveline_runs():
+    """default_driveline on one model: on CasADi's virtual machine, again (everything cached), and
+    as compiled code. Its locked mode's event functions call the log F_5/2 table."""
+    from clutchocp.engagement.model import EngagementModel
+    from clutchocp.engagement.run import simulate_engagement
+    from clutchocp.scene import load_scene
+    from clutchocp.simulation.native import compiler
+
+    model = EngagementModel(load_scene("default_driveline"))
+    runs = {"vm": simulate_engagement(model.scene, model=model), "again": simulate_engagement(model.scene, model=model)}
+    if compiler() is not None:
+        runs["native"] = simulate_engagement(model.scene, model=model, native=True)
+    return model, runs
+
+
+def test_a_second_run_of_a_model_reuses_everything_and_gives_the_same_numbers(driveline_runs):
+    _, runs = driveline_runs
+    first, again = runs["vm"], runs["again"]
+    assert again.result.stats["n_integrators_built"] == 0
+    assert np.array_equal(first.result.t, again.result.t)
+    for name in first.result.names():
+        assert np.array_equal(first.result[name], again.result[name], equal_nan=True), name
+    for key in ("engagement_time_s", "lockup_torque_jump_Nm", "peak_torque_Nm", "peak_jerk_rad_s3",
+                "torque_response_time_s", "pressure_response_time_s", "dissipated_energy_J"):
+        assert first.summary[key] == again.summary[key], key
+
+
+def test_compiled_event_functions_give_the_same_run(driveline_runs):
+    """With native code the locked mode's events (table calls) are compiled too: their values agree
+    with CasADi's to rounding, and the run has the same steps, lock-up time and jump."""
+    model, runs = driveline_runs
+    if "native" not in runs:
+        pytest.skip("no C compiler")
+    compiled = model.hybrid.compiled()
+    locked = compiled["pressing_locked"]
+    assert locked.event_values(True) is not locked.events_on                  # calls a table: compiled
+    assert compiled["pressing_slip_forward"].event_values(True) is compiled["pressing_slip_forward"].events_on
+    seg = next(s for s in runs["vm"].result.segments if s.mode == "pressing_locked")
+    xs = np.array([seg.x[k] / nominal for k, nominal in zip(locked.x_names, locked.x_nominal)])
+    pu = np.zeros(locked.pu.numel())
+    a = locked.events_on(xs, np.zeros((0, seg.t.size)), pu, seg.t)
+    b = locked.event_values(True)(xs, np.zeros((0, seg.t.size)), pu, seg.t)
+    assert np.allclose(a, b, rtol=1e-12, atol=1e-12 * np.max(np.abs(a)))
+    vm, native = runs["vm"].summary, runs["native"].summary
+    assert native["solver"]["statistics"]["n_steps"] == vm["solver"]["statistics"]["n_steps"]
+    assert native["engagement_time_s"] == pytest.approx(vm["engagement_time_s"], rel=1e-12)
+    assert native["lockup_torque_jump_Nm"] == pytest.approx(vm["lockup_torque_jump_Nm"], rel=1e-9)
+    for name in ("w_in_rad_s", "w_out_rad_s", "h_1_m", "total_torque_Nm", "output_jerk_rad_s3"):
+        a, b = runs["vm"].result[name], runs["native"].result[name]
+        assert np.allclose(a, b, rtol=1e-10, atol=1e-12 * np.nanmax(np.abs(a)), equal_nan=True), name

@@ -205,7 +205,7 @@ class _Run:
             self.monitor = EventMonitor(cm.events, self.opts.event_band)
             if not cm.events:
                 return
-            s = cm.events_on(self.xs, self.zs, self.pu, self.t).ravel()
+            s = cm.event_values(self.opts.native)(self.xs, self.zs, self.pu, self.t).ravel()
             ok = np.array(cm.f_guards(self.xs, self.zs, self.pu, self.t), float).ravel() >= 0
             fire = self.monitor.enter(s, ok)
             if fire is None:

@@ -384,10 +384,9 @@ class IdasPath:
             raise solver_error(self.name.upper(), fail.flag, left.t, cm, left.xs, left.zs)
         return np.array([best[0]]), best[1].reshape(cm.nx, 1), best[2].reshape(cm.nz, 1)
 
-    @staticmethod
-    def _events(cm, xs, zs, pu, t):
+    def _events(self, cm, xs, zs, pu, t):
         t = np.atleast_1d(np.asarray(t, float))
-        return cm.events_on(xs, zs, pu, t).reshape(len(cm.events), t.size)
+        return cm.event_values(self.options.native)(xs, zs, pu, t).reshape(len(cm.events), t.size)
 
     # ------------------------------------------------------------------ event location
     def _locate(self, cm, pu, left, right, crossings):

@@ -11,8 +11,11 @@ C). Its share is ``1 - integration_time_s / run_time_s`` of its row (the definit
 ``benchmarks/bench_sweep.py``), the median over ``--points`` points after ``--warm-up`` points
 (the first builds the model and integrators that later points reuse). Also reported: points per
 second on one core (the inverse of the mean point time), and where a point's time goes (a second
-pass over the same points with timers around the parts: scene with the overrides, integrator
-look-up and construction, event location, outputs on the grid, summary).
+pass over points between those, with timers around the parts: scene with the overrides,
+integrator look-up and construction, event location, outputs on the grid, summary).
+``cpu_share`` is the same share in CPU time of the process's thread (``time.thread_time``, around
+each point and around each ``IdasPath._run``): on a machine shared with other jobs the wall-time
+share moves with their load, the CPU-time share much less.
 
 Every (scene, engine, tree) measurement is a fresh process; the trees alternate within each scene
 and each pair repeats ``--rounds`` times, so a change of the machine's load hits both alike. The
@@ -65,11 +68,29 @@ def worker(scene, native, points, warm_up):
     from clutchocp.scene import load_scene
     from clutchocp.study.tasks import Task, simulate_point
 
+    import clutchocp.simulation.idas_path as idas_path
+
+    cpu = {"integrator": 0.0}                 # CPU time of this thread inside IdasPath._run (both trees have it)
+    inner = idas_path.IdasPath._run
+
+    def counted(self, *args):
+        start = time.thread_time()
+        try:
+            return inner(self, *args)
+        finally:
+            cpu["integrator"] += time.thread_time() - start
+    idas_path.IdasPath._run = counted
+
     nominal = load_scene(scene).value("oil.viscosity")
     task = Task(scene, "simulate", options={"native": "auto" if native else False})
     n = warm_up + points
     values = [nominal * (0.95 + 0.1 * k / (n - 1)) for k in range(n)]
-    rows = [simulate_point(task, {"oil.viscosity": v})[0] for v in values]
+    rows, cpu_shares = [], []
+    for k, v in enumerate(values):
+        cpu["integrator"], start = 0.0, time.thread_time()
+        rows.append(simulate_point(task, {"oil.viscosity": v})[0])
+        if k >= warm_up:
+            cpu_shares.append(1 - cpu["integrator"] / (time.thread_time() - start))
     bad = [r for r in rows if r["status"] != "ok" or not r["model_reused"]]
     if bad:
         raise RuntimeError(f"{scene}: {len(bad)} points failed or did not reuse the model: {bad[0]}")
@@ -83,6 +104,7 @@ def worker(scene, native, points, warm_up):
         simulate_point(task, {"oil.viscosity": 0.5 * (a + b)})
     second = time.perf_counter() - start
     return {"share": statistics.median(1 - i / r for i, r in zip(integ, run)),
+            "cpu_share": statistics.median(cpu_shares),
             "point_ms": 1e3 * statistics.median(run), "integration_ms": 1e3 * statistics.median(integ),
             "points_per_second": len(run) / sum(run), "native_used": bool(timed[0]["native_code"]),
             "n_steps": timed[0]["n_steps"],
@@ -134,12 +156,13 @@ def main(argv=None):
             entry = {}
             for label, got in runs.items():
                 best = sorted(got, key=lambda m: m["share"])[len(got) // 2]     # the median round
-                entry[label] = {**best, "share_rounds": [m["share"] for m in got]}
+                entry[label] = {**best, "share_rounds": [m["share"] for m in got],
+                                "cpu_share_rounds": [m["cpu_share"] for m in got]}
             if "against" in entry:
                 entry["point_time_this_over_against"] = entry["this"]["point_ms"] / entry["against"]["point_ms"]
             result["scenes"][f"{scene}/{engine}"] = entry
-            print(scene, engine, {k: round(v["share"], 3) for k, v in entry.items() if isinstance(v, dict)},
-                  file=sys.stderr)
+            print(scene, engine, {k: (round(v["share"], 3), round(v["cpu_share"], 3)) for k, v in entry.items()
+                                  if isinstance(v, dict)}, file=sys.stderr)
     result["load_after"] = load()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

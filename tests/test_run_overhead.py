@@ -59,9 +59,18 @@ def test_crossing_and_peak_of_a_cubic_are_exact():
     assert crossing_time(t, t**3, 2.0) is None
 
 
+def test_padded_sizes_are_at_most_a_quarter_larger_and_few():
+    from clutchocp.simulation.vectorized import padded_size
+
+    sizes = [padded_size(n) for n in range(1, 5000)]
+    assert all(n <= m <= max(n, 1.25 * (n - 1)) for n, m in zip(range(1, 5000), sizes))
+    assert sizes[:8] == list(range(1, 9)) and padded_size(17) == 20 and padded_size(1622) == 1792
+    assert len(set(sizes)) == 8 + 4 * 9 + 1        # 1..8, then four per octave up to 4096, then 5120
+
+
 def test_column_function_on_padded_maps_equals_one_call_per_sample():
-    """Maps come in powers of two with the last sample repeated: each column is still the function
-    of its own sample, and a few maps serve every sample count."""
+    """Maps are padded (the last sample repeated): each column is still the function of its own
+    sample, and a few maps serve every sample count."""
     import casadi as ca
 
     from clutchocp.simulation.compiled import ColumnFunction
@@ -75,13 +84,15 @@ def test_column_function_on_padded_maps_equals_one_call_per_sample():
         X, Z, T = rng.normal(size=(2, n)), rng.normal(size=(1, n)), rng.uniform(0, 1, n)
         reference = np.column_stack([np.array(f(X[:, k], Z[:, k], p, T[k])).ravel() for k in range(n)])
         assert np.array_equal(column(X, Z, p, T), reference)
-    assert sorted(column._maps) == [1, 4, 8, 32, 128]
+    assert sorted(column._maps) == [1, 3, 5, 20, 112]
+    column(np.zeros((2, 99)), np.zeros((1, 99)), p, np.zeros(99))              # 97-112 samples: one map
+    assert sorted(column._maps) == [1, 3, 5, 20, 112]
     assert column(np.zeros((2, 0)), np.zeros((1, 0)), p, np.zeros(0)).shape == (2, 0)
 
 
 def test_scalar_calls_of_the_numpy_translation_share_padded_maps(monkeypatch):
-    """An interpolant called on n samples runs on a map of the next power of two (the last sample
-    repeated): the values equal CasADi's sample by sample, and 40 to 64 samples share one map."""
+    """An interpolant called on n samples runs on a map of the padded size (the last sample
+    repeated): the values equal CasADi's sample by sample, and 49 to 56 samples share one map."""
     import casadi as ca
 
     from clutchocp.physics.roughness import log_F52
@@ -92,12 +103,12 @@ def test_scalar_calls_of_the_numpy_translation_share_padded_maps(monkeypatch):
     table = next(f.instructions_sx()[k].which_function() for k in range(f.n_instructions())
                  if f.instruction_id(k) == ca.OP_CALL)
     monkeypatch.setattr(vectorized, "_MAPS", {})          # the maps other tests left behind
-    for n in (40, 51, 64):
+    for n in (49, 51, 56):
         x = np.linspace(0.5, 3.0, n)
         got = vectorized._call(table, x)
         assert got.shape == (n,)
         assert np.array_equal(got, [float(table(v)) for v in x])
-    assert [m for (name, m) in vectorized._MAPS if name == table.name()] == [64]
+    assert [m for (name, m) in vectorized._MAPS if name == table.name()] == [56]
     assert vectorized._call(table, 1.5) == float(table(1.5))
 
 

@@ -109,7 +109,8 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
         A model already built for this scene (saves the symbolic assembly; a second run of the
         same model also reuses its compiled functions and IDAS integrators).
     native : bool
-        IDAS: evaluate the equations and outputs as compiled machine code
+        IDAS: evaluate the equations, the outputs and the event functions that call tables as
+        compiled machine code
         (:class:`~clutchocp.simulation.SimulationOptions` ``native``; same results, ~30 % faster
         runs, ~0.3 s of compilation per mode the first time).
     solver_options : dict, optional

@@ -16,7 +16,7 @@ import numpy as np
 
 from clutchocp.errors import ModelError
 from clutchocp.simulation.model import time_derivative
-from clutchocp.simulation.vectorized import MIN_SAMPLES, numpy_function
+from clutchocp.simulation.vectorized import MIN_SAMPLES, numpy_function, padded_size
 
 
 @dataclass(frozen=True)
@@ -61,7 +61,7 @@ class ColumnFunction:
     evaluation for a few thousand samples of a small function).
     """
 
-    def __init__(self, function, max_maps=16):
+    def __init__(self, function, max_maps=32):
         if not all(function.sparsity_in(i).is_dense() for i in range(4)) or not function.sparsity_out(0).is_dense():
             raise ModelError(f"{function.name()}: a column function needs dense inputs and output (densify them)")
         self.function = function
@@ -103,9 +103,7 @@ class ColumnFunction:
             return out
         if n == 0:
             return np.zeros((self.n_out, 0))
-        # maps come in powers of two (the last column repeated as padding): a run's many
-        # different sample counts share a few cached maps instead of building one each
-        m = 1 << (n - 1).bit_length()
+        m = padded_size(n)                         # a few cached maps serve every sample count
         _, buf, evaluate = self._map(m)
         args = [_padded(xs, nx, n, m), _padded(zs, nz, n, m), np.ascontiguousarray(np.ravel(np.asarray(pu, float))),
                 _padded(t, 1, n, m)]

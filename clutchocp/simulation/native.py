@@ -1,8 +1,9 @@
 """CasADi functions compiled to machine code (opt-in: ``SimulationOptions(native=True)``).
 
 CasADi generates C for a mode's normalised-time DAE (``CompiledMode.dae_tau``) with its Jacobian,
-and for its outputs; the system C compiler builds shared libraries that ``casadi.external``
-loads. IDAS then integrates the same equations, with the right-hand side and Jacobian evaluated
+for its outputs and, where they call tables (interpolants), for its event functions
+(``CompiledMode.event_values``); the system C compiler builds shared libraries that
+``casadi.external`` loads. IDAS then integrates the same equations, with the right-hand side and Jacobian evaluated
 as compiled code instead of CasADi's SX virtual machine: the same steps and results (bao2020:
 2012 steps, lock-up time equal to 12 digits), the run 15 ms instead of 22 ms. Compiling costs
 0.2-0.5 s per function; the libraries are kept in a per-user cache directory (:func:`cache_dir`),

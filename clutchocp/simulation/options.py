@@ -45,9 +45,10 @@ class SimulationOptions:
     chunk_growth : float or None
         IDAS, with ``chunk``: multiply the chunk by this after every call that saw no event.
     native : bool
-        IDAS: compile each mode's DAE and its Jacobian to machine code (CasADi code generation
-        and the system C compiler, see ``native.py``): the same equations and steps, a faster
-        right-hand side, 0.2-0.5 s of compilation per mode the first time. Without a C
+        IDAS: compile each mode's DAE and its Jacobian, its outputs and its event functions that
+        call tables to machine code (CasADi code generation and the system C compiler, see
+        ``native.py``): the same equations and steps, a faster right-hand side, 0.2-0.5 s of
+        compilation per function the first time. Without a C
         compiler the equations are evaluated as usual (with a warning).
     idas_options : dict
         Extra options passed to ``casadi.integrator(..., "idas", ...)`` (not to CVODES).

@@ -68,6 +68,18 @@ _MAX_MAPS = 256
 _DUMMY = np.zeros(1)
 
 
+def padded_size(n):
+    """Sample count of the map that evaluates ``n`` samples: ``n`` up to 8, else ``n`` rounded up to
+    a quarter of its octave (at most 25 % more samples, four sizes per octave). A map costs
+    0.6-1.5 ms to build and the sample counts of a run's pieces change from run to run with
+    their event times; rounded up, a few cached maps serve every count (the padding repeats the
+    last sample and is dropped from the result)."""
+    if n <= 8:
+        return n
+    quantum = 1 << ((n - 1).bit_length() - 3)
+    return -(-n // quantum) * quantum
+
+
 def _call(callee, *args):
     """``callee`` (scalar in, scalar out, e.g. an interpolant or its derivative) on every sample,
     through a map over the samples called with the buffer interface (numpy in and out)."""
@@ -75,8 +87,8 @@ def _call(callee, *args):
     n = int(np.prod(shape)) if shape else 1
     if n == 0:
         return np.zeros(shape)
-    m = 1 << (n - 1).bit_length()          # maps in powers of two, the last sample repeated: few maps
-    key = (callee.name(), m)                # serve every sample count
+    m = padded_size(n)
+    key = (callee.name(), m)
     entry = _MAPS.get(key)
     if entry is None or entry[0] is not callee:
         if len(_MAPS) >= _MAX_MAPS:

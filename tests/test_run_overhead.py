@@ -180,3 +180,27 @@ def test_compiled_event_functions_give_the_same_run(driveline_runs):
     for name in ("w_in_rad_s", "w_out_rad_s", "h_1_m", "total_torque_Nm", "output_jerk_rad_s3"):
         a, b = runs["vm"].result[name], runs["native"].result[name]
         assert np.allclose(a, b, rtol=1e-10, atol=1e-12 * np.nanmax(np.abs(a)), equal_nan=True), name
+
+
+def test_functions_without_table_calls_switch_to_numpy_sooner(monkeypatch):
+    """From MIN_SAMPLES_PLAIN samples a function that calls no table is evaluated by its numpy form
+    (the same values to rounding); one that calls a table stays on CasADi's map up to MIN_SAMPLES."""
+    import casadi as ca
+
+    from clutchocp.physics.roughness import log_F52
+    from clutchocp.simulation import vectorized
+    from clutchocp.simulation.compiled import ColumnFunction
+
+    xs, zs, pu, t = ca.SX.sym("xs", 2), ca.SX.sym("zs", 0), ca.SX.sym("pu", 1), ca.SX.sym("t")
+    plain = ColumnFunction(ca.Function("plain", [xs, zs, pu, t], [ca.vertcat(ca.exp(-xs[0]) * xs[1], pu * t)]))
+    table = ColumnFunction(ca.Function("table", [xs, zs, pu, t], [ca.vertcat(log_F52(1 + xs[0] ** 2), pu * t)]))
+    n = vectorized.MIN_SAMPLES_PLAIN + 72
+    assert n < vectorized.MIN_SAMPLES
+    rng = np.random.default_rng(5)
+    X, Z, P, T = rng.uniform(0, 2, (2, n)), np.zeros((0, n)), np.array([0.7]), np.linspace(0, 1, n)
+    for column in (plain, table):
+        got = column(X, Z, P, T)
+        reference = np.column_stack([np.array(column.function(X[:, k], Z[:, k], P, T[k])).ravel() for k in range(n)])
+        assert np.allclose(got, reference, rtol=1e-14, atol=0)
+    assert not plain._maps and plain._numpy is not None           # numpy form, no map built
+    assert list(table._maps) == [vectorized.padded_size(n)]          # CasADi's map

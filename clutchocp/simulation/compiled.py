@@ -16,6 +16,7 @@ import numpy as np
 
 from clutchocp.errors import ModelError
 from clutchocp.simulation.model import time_derivative
+from clutchocp.simulation import vectorized
 from clutchocp.simulation.vectorized import MIN_SAMPLES, numpy_function, padded_size
 
 
@@ -69,13 +70,16 @@ class ColumnFunction:
         self.n_out = function.size1_out(0)
         self._maps = {}
         self._max_maps = max_maps
+        self._calls = function.is_a("SXFunction") and any(
+            function.instruction_id(k) == ca.OP_CALL for k in range(function.n_instructions()))
         self._numpy_built = False
         self._numpy_fn = None
 
     @property
     def _numpy(self):
         """The numpy translation (many samples: one numpy operation per instruction), made on first
-        use: a run whose output pieces all have fewer than MIN_SAMPLES samples never pays for it."""
+        use: a run whose output pieces are all shorter than the threshold (MIN_SAMPLES, or
+        MIN_SAMPLES_PLAIN without calls of tables) never pays for it."""
         if not self._numpy_built:
             self._numpy_fn, self._numpy_built = numpy_function(self.function), True
         return self._numpy_fn
@@ -95,7 +99,7 @@ class ColumnFunction:
         t = np.atleast_1d(np.asarray(t, float)).ravel()
         n = t.size
         nx, nz = self.sizes[:2]
-        if n >= MIN_SAMPLES and self._numpy is not None:
+        if n >= (MIN_SAMPLES if self._calls else vectorized.MIN_SAMPLES_PLAIN) and self._numpy is not None:
             out = np.empty((self.n_out, n))
             with np.errstate(all="ignore"):       # as CasADi: NaN/inf where the expression gives them
                 self._numpy([np.reshape(np.asarray(xs, float), (nx, n)), np.reshape(np.asarray(zs, float), (nz, n)),

@@ -6,7 +6,8 @@ mode on a long output grid (a locked phase of 1 700 samples) numpy does better: 
 instruction list, translated once into Python source with one numpy operation per instruction
 on arrays of all samples, costs about 1 us per instruction plus under 1 ns per instruction and
 sample. :func:`numpy_function` makes that translation; :class:`~clutchocp.simulation.compiled.ColumnFunction`
-uses it above :data:`MIN_SAMPLES` samples.
+uses it above :data:`MIN_SAMPLES` samples (:data:`MIN_SAMPLES_PLAIN` for a function that calls no
+table).
 
 Operations are the IEEE double operations of CasADi's C code (numpy's transcendental functions
 agree to within an ulp or two); ``if_else`` keeps CasADi's semantics (``if_else_zero(c, x)`` is
@@ -24,6 +25,9 @@ from scipy.special import erf
 import casadi as ca
 
 MIN_SAMPLES = 600      # measured break-even with CasADi's map: ~500 samples (2.4 k and 0.6 k instructions)
+MIN_SAMPLES_PLAIN = 128  # the same for a function without calls of tables: ~50-150 samples (measured on the
+                         # seed scenes' outputs and event functions, 3 to 2.6 k instructions); the calls are
+                         # what the numpy form pays per sample
 
 _UNARY = {
     "OP_EXP": "np.exp({0})", "OP_LOG": "np.log({0})", "OP_SQRT": "np.sqrt({0})", "OP_SIN": "np.sin({0})",

@@ -14,8 +14,8 @@ second on one core (the inverse of the mean point time), and where a point's tim
 pass over points between those, with timers around the parts: scene with the overrides,
 integrator look-up and construction, event location, outputs on the grid, summary).
 ``cpu_share`` is the same share in CPU time of the process's thread (``time.thread_time``, around
-each point and around each ``IdasPath._run``): on a machine shared with other jobs the wall-time
-share moves with their load, the CPU-time share much less.
+each point and around each ``IdasPath._run``), ``cpu_point_ms`` a point's CPU time: on a machine
+shared with other jobs the wall times move with their load, the CPU times much less.
 
 Every (scene, engine, tree) measurement is a fresh process; the trees alternate within each scene
 and each pair repeats ``--rounds`` times, so a change of the machine's load hits both alike. The
@@ -85,12 +85,13 @@ def worker(scene, native, points, warm_up):
     task = Task(scene, "simulate", options={"native": "auto" if native else False})
     n = warm_up + points
     values = [nominal * (0.95 + 0.1 * k / (n - 1)) for k in range(n)]
-    rows, cpu_shares = [], []
+    rows, cpu_shares, cpu_points = [], [], []
     for k, v in enumerate(values):
         cpu["integrator"], start = 0.0, time.thread_time()
         rows.append(simulate_point(task, {"oil.viscosity": v})[0])
         if k >= warm_up:
-            cpu_shares.append(1 - cpu["integrator"] / (time.thread_time() - start))
+            cpu_points.append(time.thread_time() - start)
+            cpu_shares.append(1 - cpu["integrator"] / cpu_points[-1])
     bad = [r for r in rows if r["status"] != "ok" or not r["model_reused"]]
     if bad:
         raise RuntimeError(f"{scene}: {len(bad)} points failed or did not reuse the model: {bad[0]}")
@@ -104,7 +105,7 @@ def worker(scene, native, points, warm_up):
         simulate_point(task, {"oil.viscosity": 0.5 * (a + b)})
     second = time.perf_counter() - start
     return {"share": statistics.median(1 - i / r for i, r in zip(integ, run)),
-            "cpu_share": statistics.median(cpu_shares),
+            "cpu_share": statistics.median(cpu_shares), "cpu_point_ms": 1e3 * statistics.median(cpu_points),
             "point_ms": 1e3 * statistics.median(run), "integration_ms": 1e3 * statistics.median(integ),
             "points_per_second": len(run) / sum(run), "native_used": bool(timed[0]["native_code"]),
             "n_steps": timed[0]["n_steps"],
@@ -160,6 +161,8 @@ def main(argv=None):
                                 "cpu_share_rounds": [m["cpu_share"] for m in got]}
             if "against" in entry:
                 entry["point_time_this_over_against"] = entry["this"]["point_ms"] / entry["against"]["point_ms"]
+                entry["cpu_point_time_this_over_against"] = (entry["this"]["cpu_point_ms"]
+                                                             / entry["against"]["cpu_point_ms"])
             result["scenes"][f"{scene}/{engine}"] = entry
             print(scene, engine, {k: (round(v["share"], 3), round(v["cpu_share"], 3)) for k, v in entry.items()
                                   if isinstance(v, dict)}, file=sys.stderr)

@@ -15,7 +15,9 @@ pass over points between those, with timers around the parts: scene with the ove
 integrator look-up and construction, event location, outputs on the grid, summary).
 ``cpu_share`` is the same share in CPU time of the process's thread (``time.thread_time``, around
 each point and around each ``IdasPath._run``), ``cpu_point_ms`` a point's CPU time: on a machine
-shared with other jobs the wall times move with their load, the CPU times much less.
+shared with other jobs the wall times move with their load, the CPU times much less, and
+``fastest_point_ms`` (the fastest point of all rounds, wall time) estimates a point's cost without
+the other jobs.
 
 Every (scene, engine, tree) measurement is a fresh process; the trees alternate within each scene
 and each pair repeats ``--rounds`` times, so a change of the machine's load hits both alike. The
@@ -106,6 +108,7 @@ def worker(scene, native, points, warm_up):
     second = time.perf_counter() - start
     return {"share": statistics.median(1 - i / r for i, r in zip(integ, run)),
             "cpu_share": statistics.median(cpu_shares), "cpu_point_ms": 1e3 * statistics.median(cpu_points),
+            "cpu_point_min_ms": 1e3 * min(cpu_points), "point_min_ms": 1e3 * min(run),
             "point_ms": 1e3 * statistics.median(run), "integration_ms": 1e3 * statistics.median(integ),
             "points_per_second": len(run) / sum(run), "native_used": bool(timed[0]["native_code"]),
             "n_steps": timed[0]["n_steps"],
@@ -163,6 +166,9 @@ def main(argv=None):
                 entry["point_time_this_over_against"] = entry["this"]["point_ms"] / entry["against"]["point_ms"]
                 entry["cpu_point_time_this_over_against"] = (entry["this"]["cpu_point_ms"]
                                                              / entry["against"]["cpu_point_ms"])
+                fastest = {label: min(m["point_min_ms"] for m in got) for label, got in runs.items()}
+                entry["fastest_point_ms"] = fastest
+                entry["fastest_point_this_over_against"] = fastest["this"] / fastest["against"]
             result["scenes"][f"{scene}/{engine}"] = entry
             print(scene, engine, {k: (round(v["share"], 3), round(v["cpu_share"], 3)) for k, v in entry.items()
                                   if isinstance(v, dict)}, file=sys.stderr)

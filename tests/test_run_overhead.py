@@ -204,3 +204,19 @@ def test_functions_without_table_calls_switch_to_numpy_sooner(monkeypatch):
         assert np.allclose(got, reference, rtol=1e-14, atol=0)
     assert not plain._maps and plain._numpy is not None           # numpy form, no map built
     assert list(table._maps) == [vectorized.padded_size(n)]          # CasADi's map
+
+
+def test_single_sample_functions_equal_the_casadi_calls(driveline_runs):
+    """ode, guards and resets at one sample through the buffer interface equal CasADi's own call."""
+    import casadi as ca
+
+    model, _ = driveline_runs
+    cm = model.hybrid.compiled()["pressing_slip_forward"]
+    rng = np.random.default_rng(11)
+    xs = (np.asarray(model.initial_state) / cm.x_nominal) * (1 + 0.1 * rng.random(cm.nx))
+    zs, pu, t = np.zeros(cm.nz), rng.uniform(0.5, 1.5, cm.pu.numel()), 0.13
+    pairs = [("ode", cm.f_ode), ("guards", cm.f_guards)] + [(("reset", i), f) for i, f in enumerate(cm.resets)]
+    assert len(pairs) > 2
+    for what, function in pairs:
+        reference = np.array(ca.densify(function(xs, zs, pu, t))).ravel()
+        assert np.array_equal(cm.at(what, xs, zs, pu, t), reference), what

@@ -111,7 +111,7 @@ class ColumnFunction:
         _, buf, evaluate = self._map(m)
         args = [_padded(xs, nx, n, m), _padded(zs, nz, n, m), np.ascontiguousarray(np.ravel(np.asarray(pu, float))),
                 _padded(t, 1, n, m)]
-        out = np.empty((m, self.n_out))
+        out = np.zeros((m, self.n_out))           # CasADi leaves outputs that are constant zeros unwritten
         dummy = np.zeros(1)
         for i, a in enumerate(args):
             buf.set_arg(i, memoryview(a if a.size else dummy))
@@ -183,6 +183,7 @@ class CompiledMode:
         self._native_dae = None
         self._native_outputs_on = None
         self._native_events_on = None
+        self._on_samples = {}
         self.integrators = {}       # cached casadi integrators of this mode (see idas_path)
 
     def build_resets(self, modes):
@@ -224,6 +225,22 @@ class CompiledMode:
             from clutchocp.simulation.native import native_dae
             self._native_dae = native_dae(self) or False
         return self._native_dae or None
+
+    def on_samples(self, what):
+        """Column function (numpy in and out, no DM conversions: a few us a call instead of ~20 us)
+        of ``"ode"``, ``"guards"`` or ``("reset", i)``: the same Function as ``f_ode``, ``f_guards``
+        and ``resets[i]`` with its output densified, built on first use."""
+        function = self._on_samples.get(what)
+        if function is None:
+            source = self.resets[what[1]] if isinstance(what, tuple) else {"ode": self.f_ode, "guards": self.f_guards}[what]
+            dense = ca.Function(f"{source.name()}_dense", [self.xs, self.zs, self.pu, self.t],
+                                [ca.densify(source(self.xs, self.zs, self.pu, self.t))])
+            function = self._on_samples[what] = ColumnFunction(dense)
+        return function
+
+    def at(self, what, xs, zs, pu, t):
+        """:meth:`on_samples` ``what`` at one sample: a 1-D array."""
+        return self.on_samples(what)(xs, zs, pu, t)[:, 0]
 
     def event_values(self, native=False):
         """The column function of the scaled event functions a run uses: :attr:`events_on`, or with

@@ -206,7 +206,7 @@ class _Run:
             if not cm.events:
                 return
             s = cm.event_values(self.opts.native)(self.xs, self.zs, self.pu, self.t).ravel()
-            ok = np.array(cm.f_guards(self.xs, self.zs, self.pu, self.t), float).ravel() >= 0
+            ok = cm.at("guards", self.xs, self.zs, self.pu, self.t) >= 0
             fire = self.monitor.enter(s, ok)
             if fire is None:
                 return
@@ -228,7 +228,7 @@ class _Run:
                               f"(last: '{spec.name}' from '{cm.name}' to '{spec.target}'). Try: check the events "
                               "for chatter, or raise max_switches.")
         target = self.compiled[spec.target]
-        xs_new = np.array(cm.resets[i](self.xs, self.zs, self.pu, t), float).ravel()
+        xs_new = cm.at(("reset", i), self.xs, self.zs, self.pu, t)
         known = cm.z_dict(self.zs)
         guess = np.array([known[n] / s if n in known else g
                           for n, s, g in zip(target.z_names, target.z_nominal, target.z_guess_scaled)])
@@ -241,7 +241,7 @@ class _Run:
         self._add(t, xs_new, zs_new, self.pu)
 
     def _outputs(self, cm, xs, zs):
-        values = np.array(cm.f_outputs(xs, zs, self.pu, self.t), float).ravel()
+        values = cm.outputs_on(xs, zs, self.pu, self.t)[:, 0]
         return dict(zip(cm.output_names, values))
 
     # ------------------------------------------------------------- main loop
@@ -269,7 +269,7 @@ class _Run:
                 for i in crossing.events:
                     self.monitor.state[i] = ARMED
                 continue
-            guards = np.array(self.cm.f_guards(self.xs, self.zs, self.pu, self.t), float).ravel()
+            guards = self.cm.at("guards", self.xs, self.zs, self.pu, self.t)
             fired = next((i for i in crossing.events if guards[i] >= 0), None)
             if fired is None:
                 for i in crossing.events:

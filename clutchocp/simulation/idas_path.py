@@ -424,8 +424,8 @@ class IdasPath:
         ta, xa, za = left.payload()
         tb, xb, zb = right.payload()
         h = tb - ta
-        da = np.array(cm.f_ode(xa, za, pu, ta), dtype=float).ravel()
-        db = np.array(cm.f_ode(xb, zb, pu, tb), dtype=float).ravel()
+        da = cm.at("ode", xa, za, pu, ta)
+        db = cm.at("ode", xb, zb, pu, tb)
         th = np.linspace(0.0, 1.0, n)
         h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
         h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2

@@ -170,8 +170,8 @@ def main(argv=None):
                 entry["fastest_point_ms"] = fastest
                 entry["fastest_point_this_over_against"] = fastest["this"] / fastest["against"]
             result["scenes"][f"{scene}/{engine}"] = entry
-            print(scene, engine, {k: (round(v["share"], 3), round(v["cpu_share"], 3)) for k, v in entry.items()
-                                  if isinstance(v, dict)}, file=sys.stderr)
+            print(scene, engine, {k: (round(entry[k]["share"], 3), round(entry[k]["cpu_share"], 3)) for k in trees},
+                  file=sys.stderr)
     result["load_after"] = load()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

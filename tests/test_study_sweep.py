@@ -214,3 +214,11 @@ def test_samples_are_the_seeded_draws_of_the_scene_uncertainty(tmp_path):
     assert [r["actuation.time_constant"] for r in rows] == [d["actuation.time_constant"] for d in draws]
     assert summary["fields"] == ["actuation.time_constant"] and summary["points_ok"] == 3
     assert (tmp_path / "s" / "sample_histograms.png").is_file() and (tmp_path / "s" / "sample_scatter.png").is_file()
+
+
+def test_the_sweep_command_writes_its_folder_and_says_so(tmp_path, capsys):
+    code = main(["sweep", "zhang2021", "--grid", "oil.viscosity=0.04:0.06:2", "--out", str(tmp_path / "s"),
+                 "--engine", "serial", "--native", "off"])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert f"wrote {tmp_path / 's'}: sweep_lines.png, summary.json, results.csv" in out

@@ -3,9 +3,15 @@
 Engines
 -------
 ``"serial"``  every unit in this process (debugging, one worker).
-``"local"``   a pool of local worker processes (``multiprocessing``, spawned; default: one per core).
+``"local"``   a pool of local worker processes (``multiprocessing``; default: one per core). On Linux
+              the workers are forked from this process after it has run the first point (or, for
+              an optimize sweep, built the first worker's problem): they start with the modules
+              imported and the reused model, its compiled code and integrators already built
+              (:func:`clutchocp.study.tasks.warm_up`). Elsewhere they are spawned and build their own.
 ``"dask"``    a Dask distributed cluster: the scheduler at ``scheduler`` (``tcp://host:8786``) or,
-              without one, a ``LocalCluster`` of worker processes (one thread each) started here.
+              without one, a ``LocalCluster`` of worker processes (one thread each) started here;
+              on Linux those are forked after the warm-up, as for ``"local"``. The points go to
+              the workers in batches (:func:`batches`), each batch one Dask task.
 
 The units are sent as plain data (:mod:`clutchocp.study.tasks`); the results come back to this
 process as they finish and are handed to ``on_result`` one point at a time (so they are written as
@@ -13,15 +19,17 @@ they arrive). Ctrl-C cancels what has not started, stops the workers and raises
 :class:`StudyInterrupted`; the points already handed over stay written.
 """
 
+import contextlib
 import multiprocessing
 import os
 import signal
 import sys
+import threading
 
 from tqdm import tqdm
 
 from ..errors import ClutchocpError, ModelError
-from .tasks import run_unit
+from .tasks import run_unit, warm_up
 
 ENGINES = ("local", "dask", "serial")
 
@@ -46,8 +54,43 @@ def _ignore_sigint():
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _run_unit_args(args):
-    return run_unit(*args)
+@contextlib.contextmanager
+def _sigint_held():
+    """Hold Ctrl-C back while worker processes are forked: a SIGINT during a fork runs its handler
+    inside the fork hooks, where the exception is lost; held, it is delivered after the block.
+    The workers start with it held and ignore it (:func:`_ignore_sigint`)."""
+    held = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
+    if held:
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        if held:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+def _run_units(task, units):
+    """Several units in one call (a batch sent to a worker at once): their results, in order."""
+    return [result for unit in units for result in run_unit(task, unit)]
+
+
+def _run_units_args(args):
+    return _run_units(*args)
+
+
+def start_method():
+    """``"fork"`` on Linux (the workers inherit what this process has built), else ``"spawn"``."""
+    return "fork" if sys.platform.startswith("linux") and "fork" in multiprocessing.get_all_start_methods() \
+        else "spawn"
+
+
+def batches(units, workers, per_worker=8):
+    """``units`` cut into about ``per_worker`` batches per worker (consecutive units together; fewer,
+    larger messages than one per unit, and still a balanced end: the last batches are small)."""
+    if not units:
+        return []
+    size = max(1, len(units) // (workers * per_worker))
+    return [units[k:k + size] for k in range(0, len(units), size)]
 
 
 def default_workers():
@@ -127,19 +170,35 @@ def execute(task, units, on_result, *, engine="local", workers=None, scheduler=N
 
 
 def _run_local(task, units, deliver, workers):
-    """A spawned process pool; results in completion order."""
+    """A process pool; results in completion order (each batch's as it finishes)."""
+    method = start_method()
+    if method == "fork":                      # build once here; the forked workers inherit it
+        done, units = warm_up(task, units)
+        deliver(done)
     n = max(1, min(workers, len(units)))
-    pool = multiprocessing.get_context("spawn").Pool(n, initializer=_ignore_sigint)
+    if not units:
+        return {"engine": "local", "workers": n, "start_method": method}
+    with _sigint_held():
+        pool = multiprocessing.get_context(method).Pool(n, initializer=_ignore_sigint)
     try:
-        for results in pool.imap_unordered(_run_unit_args, [(task, unit) for unit in units], chunksize=1):
+        for results in pool.imap_unordered(_run_units_args, [(task, b) for b in batches(units, n)], chunksize=1):
             deliver(results)
         pool.close()
     except BaseException:
-        pool.terminate()              # Ctrl-C or an error in this process: stop the workers now
+        _stop_pool(pool)              # Ctrl-C or an error in this process: stop the workers now
         raise
     finally:
         pool.join()
-    return {"engine": "local", "workers": n}
+    return {"engine": "local", "workers": n, "start_method": method}
+
+
+def _stop_pool(pool):
+    """Stop a pool's workers now. ``Pool.terminate`` first takes the task queue's read lock, which an
+    idle worker holds while it waits for a task (seen: a Ctrl-C near the end of a sweep hung there);
+    one stop sentinel per worker (``None``, what ``Pool.close`` sends) lets such a worker exit."""
+    for _ in range(len(pool._pool)):
+        pool._inqueue.put(None)
+    pool.terminate()
 
 
 def _run_dask(task, units, deliver, workers, scheduler):
@@ -154,8 +213,15 @@ def _run_dask(task, units, deliver, workers, scheduler):
         if scheduler:
             client = Client(scheduler, timeout="5s")
         else:
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
+            import dask
+
+            method = start_method()
+            if method == "fork":            # the forked workers inherit what the warm-up built
+                done, units = warm_up(task, units)
+                deliver(done)
+            with dask.config.set({"distributed.worker.multiprocessing-method": method}):
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)
             client = Client(cluster)
     except (OSError, TimeoutError) as exc:
         if cluster is not None:
@@ -165,7 +231,8 @@ def _run_dask(task, units, deliver, workers, scheduler):
     futures = []
     try:
         n_workers = len(client.scheduler_info()["workers"])
-        futures = client.map(run_unit, [task] * len(units), units, pure=False)
+        parts = batches(units, max(n_workers, 1))
+        futures = client.map(_run_units, [task] * len(parts), parts, pure=False)
         for future in as_completed(futures):
             deliver(future.result())
         return {"engine": "dask", "workers": n_workers, "address": client.scheduler.address}

@@ -25,14 +25,16 @@ def serial_rows(tmp_path_factory):
 
 
 @pytest.mark.parametrize("n_units, workers", [(200, 2), (19, 2), (7, 4), (1, 8), (0, 2)])
-def test_batches_keep_every_unit_once_in_order_and_about_eight_per_worker(n_units, workers):
+def test_batches_keep_every_unit_once_in_order_and_shrink_to_single_units(n_units, workers):
     units = [[{"k": float(i)}] for i in range(n_units)]
     parts = batches(units, workers)
     assert [u for part in parts for u in part] == units
-    assert all(parts)
-    if n_units >= 8 * workers:
-        assert 8 * workers <= len(parts) <= 8 * workers + 8 * workers
-        assert max(len(p) for p in parts) == n_units // (8 * workers)
+    sizes = [len(p) for p in parts]
+    assert all(sizes) and sizes == sorted(sizes, reverse=True)
+    if n_units:
+        assert sizes[0] == -(-n_units // (4 * workers)) and sizes[-1] == 1
+    if n_units == 200:                    # 25, 22, 20, 17 ... 1: 29 messages instead of 200
+        assert sizes[:4] == [25, 22, 20, 17] and len(parts) < 50
 
 
 def test_local_workers_give_the_rows_of_a_serial_sweep(tmp_path, serial_rows):

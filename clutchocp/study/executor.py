@@ -84,13 +84,16 @@ def start_method():
         else "spawn"
 
 
-def batches(units, workers, per_worker=8):
-    """``units`` cut into about ``per_worker`` batches per worker (consecutive units together; fewer,
-    larger messages than one per unit, and still a balanced end: the last batches are small)."""
-    if not units:
-        return []
-    size = max(1, len(units) // (workers * per_worker))
-    return [units[k:k + size] for k in range(0, len(units), size)]
+def batches(units, workers, share=4):
+    """``units`` cut into batches of consecutive units, each ``1 / (share * workers)`` of the units
+    left (rounded up): large batches first (few messages), down to single units at the end, so
+    that the workers finish together."""
+    out, start = [], 0
+    while start < len(units):
+        size = -(-(len(units) - start) // (share * workers))
+        out.append(units[start:start + size])
+        start += size
+    return out
 
 
 def default_workers():

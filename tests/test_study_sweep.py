@@ -189,6 +189,7 @@ def test_an_optimize_chain_warm_starts_and_finds_the_cold_optimum(tmp_path):
     rows = read_rows(tmp_path / "s")
     assert [r["status"] for r in rows] == ["ok", "ok"]
     assert [r["warm_start"] for r in rows] == [False, True]
+    assert [r["problem_reused"] for r in rows] == [True, True]            # one problem for both points
     scene = load_scene("default_driveline", overrides=dict(EQUAL_SPLIT, **{"load.torque": rows[1]["load.torque"]}))
     cold = EngagementOCP(scene, intervals=12).solve()
     # the same optimum (measured: warm and cold agree to 1e-14; IPOPT's tolerance allows more)
@@ -222,3 +223,12 @@ def test_the_sweep_command_writes_its_folder_and_says_so(tmp_path, capsys):
     out = capsys.readouterr().out
     assert code == 0
     assert f"wrote {tmp_path / 's'}: sweep_lines.png, summary.json, results.csv" in out
+
+
+def test_model_per_point_gives_each_optimize_point_its_own_problem(tmp_path):
+    code = main(["sweep", "default_driveline", "--task", "optimize", "--grid", "load.torque=100:100:1",
+                 "--set", f"roughness.sigma_1={EQUAL_SPLIT['roughness.sigma_1']}",
+                 "--set", f"roughness.sigma_2={EQUAL_SPLIT['roughness.sigma_2']}",
+                 "--intervals", "8", "--no-verify", "--engine", "serial", "--model-per-point", "--out", str(tmp_path / "s")])
+    assert code == 0
+    assert [r["problem_reused"] for r in read_rows(tmp_path / "s")] == [False]

@@ -45,6 +45,13 @@ class StudyInterrupted(KeyboardInterrupt):
         self.done, self.total = done, total
 
 
+class _Bar(tqdm):
+    """tqdm without its monitor thread: the workers are forked from this process, and a fork
+    copies only the forking thread (a lock another thread holds stays held in the child)."""
+
+    monitor_interval = 0
+
+
 class EngineError(ClutchocpError, RuntimeError):
     """The execution engine could not be started or reached (e.g. no scheduler at the address)."""
 
@@ -143,7 +150,7 @@ def execute(task, units, on_result, *, engine="local", workers=None, scheduler=N
     """
     check_engine(engine, workers)
     total = sum(len(u) for u in units)
-    bar = tqdm(total=total, unit="point", file=sys.stderr, disable=not progress, dynamic_ncols=True,
+    bar = _Bar(total=total, unit="point", file=sys.stderr, disable=not progress, dynamic_ncols=True,
                desc=f"{task.kind} {task.scene}")
     counter = {"done": 0}
 

@@ -4,10 +4,11 @@ Engines
 -------
 ``"serial"``  every unit in this process (debugging, one worker).
 ``"local"``   a pool of local worker processes (``multiprocessing``; default: one per core). On Linux
-              the workers are forked from this process after it has run the first point (or, for
-              an optimize sweep, built the first worker's problem): they start with the modules
-              imported and the reused model, its compiled code and integrators already built
-              (:func:`clutchocp.study.tasks.warm_up`). Elsewhere they are spawned and build their own.
+              the workers are forked from this process after it has run the first point of a
+              simulate sweep: they start with the modules imported and the reused model, its
+              compiled code and integrators already built (:func:`clutchocp.study.tasks.warm_up`;
+              the workers of an optimize sweep build their own problem, each on its own path).
+              Elsewhere they are spawned and build their own.
 ``"dask"``    a Dask distributed cluster: the scheduler at ``scheduler`` (``tcp://host:8786``) or,
               without one, a ``LocalCluster`` of worker processes (one thread each) started here;
               on Linux those are forked after the warm-up, as for ``"local"``. The points go to

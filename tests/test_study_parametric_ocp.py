@@ -67,3 +67,11 @@ def test_the_moved_weights_give_each_term_the_points_own_reference(reused):
 def test_a_field_the_problem_needs_as_a_number_is_not_reused(base):
     # the input speed sets the initial state and its scale
     assert parametric_ocp.build(base, ("driveline.input_speed",), intervals=12) is None
+
+
+def test_a_point_that_changes_more_than_the_swept_values_is_refused(base, reused):
+    # the pressure limit scales the command and bounds it: not a swept value of this problem
+    other = base.with_overrides({"load.torque": 100.0, "oil.viscosity": 0.06, "actuation.max_pressure": 2.0e6})
+    with pytest.raises(parametric_ocp.NotReusable):
+        reused.set_point(other)
+    assert reused.holds_torque

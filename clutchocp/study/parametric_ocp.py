@@ -35,6 +35,9 @@ The time cap of a solve stays 20 first-point lock times (``t_max`` above it is n
 bound on either problem).
 """
 
+import copy
+import time
+
 import casadi as ca
 import numpy as np
 
@@ -42,8 +45,11 @@ from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..optimal.bound import output_jerk_share
 from ..optimal.heat import heat_limits
+from ..engagement.run import EngagementResult, summarize
 from ..optimal.problem import OBJECTIVE_TERMS, SLIP_MODE, EngagementOCP
+from ..optimal.replay import CommandModel
 from ..scene.symbolic import SymbolicScene
+from ..simulation import HybridModel, SimulationOptions, simulate
 from . import parametric
 
 
@@ -148,7 +154,8 @@ class SweepOCP(EngagementOCP):
             self.model, template = model, self.scales
             point_scales = self._scales()            # the point's references (the ordinary build's scales)
             self.scales = template
-            if not self.holds_torque:
+            holds, self.holds_torque = self.holds_torque, True      # the reused problem's, as built
+            if not holds:
                 raise NotReusable("the lock carries no torque at this point")
         self.point_scales = point_scales
         self.theta_value = field_values(scene, self.parameter_names)
@@ -175,6 +182,27 @@ class SweepOCP(EngagementOCP):
         view, values = self._baseline_model.for_point(scene)
         return simulate_engagement(scene, model=view, parameters=values)
 
+    def fastest_run(self):
+        """The IDAS run of a step to :attr:`apply_pressure` at this point (as the ordinary
+        ``fastest_run``), on one command model with the swept fields as parameters where that
+        agrees with the ordinary run at the first point."""
+        if self._fastest is None:
+            if not hasattr(self, "_step_model"):
+                self._step_model = StepRuns(self.scene, self.parameter_names)
+                try:
+                    agree = parametric.agrees(self._step_model.run(self.scene, self.apply_pressure).summary,
+                                              super().fastest_run().summary)
+                except Exception:
+                    agree = False
+                self._step_model = self._step_model if agree else None
+            if self._step_model is None:
+                return super().fastest_run()
+            run = self._step_model.run(self.scene, self.apply_pressure)
+            if run.summary["engagement_time_s"] is None:
+                return super().fastest_run()                    # its error message
+            self._fastest = run
+        return self._fastest
+
     def parameter_values(self, weights):
         """The weights moved onto the first point's scales (module notes), then theta."""
         sc, pt = self.scales, self.point_scales
@@ -200,6 +228,34 @@ class SweepOCP(EngagementOCP):
             self._exact = SweepOCP(self.scene, self.parameter_names, smooth=False, polish=False,
                                    baseline=self.baseline, transcription=self.transcription, **self.options)
         return self._exact
+
+
+class StepRuns:
+    """IDAS runs of a constant pressure command on the exact model of a scene with the fields
+    ``names`` as parameters: :func:`clutchocp.optimal.replay.simulate_command` of a step, for every
+    point of a sweep on one model (its integrators built once)."""
+
+    def __init__(self, scene, names):
+        symbolic = SymbolicScene(scene, names)
+        self.names = tuple(names)
+        self.model = CommandModel(symbolic)
+        hybrid = self.model.hybrid
+        self.hybrid = HybridModel(list(hybrid.modes.values()), p=symbolic.symbols, u=hybrid.u or None, t=hybrid.t)
+
+    def run(self, scene, value):
+        """The step to ``value`` [Pa] at t = 0 until simulation.t_end, at the point ``scene``
+        (the options and output grid of ``simulate_command``)."""
+        eng = copy.copy(self.model.engagement)
+        eng.scene = scene
+        t_end = scene.value("simulation.t_end")
+        options = SimulationOptions(rtol=scene.value("simulation.rtol"), atol=scene.value("simulation.atol"),
+                                    chunk=32, chunk_growth=2.0)
+        grid = np.unique(np.concatenate([np.linspace(0.0, t_end, 2001), [0.0]]))
+        x0 = dict(zip(eng.state_names, eng.initial_state))
+        start = time.perf_counter()
+        result = simulate(self.hybrid, x0, grid, mode=eng.initial_mode(), u=self.model.inputs([0.0], [value]),
+                          p={name: float(scene.value(name)) for name in self.names}, options=options)
+        return EngagementResult(eng, result, summarize(eng, result, time.perf_counter() - start, options, "idas"))
 
 
 def build(scene, names, **options):

@@ -232,3 +232,17 @@ def test_model_per_point_gives_each_optimize_point_its_own_problem(tmp_path):
                  "--intervals", "8", "--no-verify", "--engine", "serial", "--model-per-point", "--out", str(tmp_path / "s")])
     assert code == 0
     assert [r["problem_reused"] for r in read_rows(tmp_path / "s")] == [False]
+
+
+def test_ctrl_c_while_the_figures_are_drawn_says_that_every_point_is_kept(tmp_path, monkeypatch):
+    import clutchocp.study.run as study_run
+    from clutchocp.study import StudyInterrupted
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(study_run, "draw_study", interrupted)
+    with pytest.raises(StudyInterrupted, match="interrupted after 2 of 2 points; the finished points are kept"):
+        run_sweep("zhang2021", tmp_path / "s", grid=["oil.viscosity=0.04:0.06:2"], engine="serial", progress=False,
+                  options={"native": False})
+    assert len(read_rows(tmp_path / "s")) == 2 and not (tmp_path / "s" / LOCK).exists()

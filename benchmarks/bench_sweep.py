@@ -1,7 +1,7 @@
 """Benchmark of sweeps (not a test): parallel efficiency, Dask against the local pool, runs per second
 per core, the share of a run spent outside the integrator calls, warm-started optimize maps.
 
-    PYTHONPATH=. python benchmarks/bench_sweep.py --out out/bench_sweep          # about 6 minutes
+    PYTHONPATH=. python benchmarks/bench_sweep.py --out out/bench_sweep          # several minutes (three optimize maps)
     PYTHONPATH=. python benchmarks/bench_sweep.py --points 40 --map 3            # a quick look
     PYTHONPATH=. python benchmarks/bench_sweep.py --skip share,optimize --model-per-point  # heavier points
 

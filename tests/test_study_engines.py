@@ -52,3 +52,13 @@ def test_a_dask_local_cluster_started_by_the_sweep_gives_the_rows_of_a_serial_sw
                         options={"native": False})
     assert summary["engine"]["engine"] == "dask" and summary["engine"]["workers"] == 2
     assert _rows(tmp_path / "s") == serial_rows
+
+
+def test_spawned_workers_where_fork_is_not_used_give_the_same_rows(tmp_path, serial_rows, monkeypatch):
+    from clutchocp.study import executor
+
+    monkeypatch.setattr(executor, "start_method", lambda: "spawn")       # as on macOS and Windows
+    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID, engine="local", workers=2, progress=False,
+                        options={"native": False})
+    assert summary["engine"]["start_method"] == "spawn" and summary["engine"]["workers"] == 2
+    assert _rows(tmp_path / "s") == serial_rows

@@ -229,7 +229,8 @@ def test_model_per_point_gives_each_optimize_point_its_own_problem(tmp_path):
     code = main(["sweep", "default_driveline", "--task", "optimize", "--grid", "load.torque=100:100:1",
                  "--set", f"roughness.sigma_1={EQUAL_SPLIT['roughness.sigma_1']}",
                  "--set", f"roughness.sigma_2={EQUAL_SPLIT['roughness.sigma_2']}",
-                 "--intervals", "8", "--no-verify", "--engine", "serial", "--model-per-point", "--out", str(tmp_path / "s")])
+                 "--intervals", "8", "--no-verify", "--engine", "serial", "--model-per-point",
+                 "--out", str(tmp_path / "s")])
     assert code == 0
     assert [r["problem_reused"] for r in read_rows(tmp_path / "s")] == [False]
 

@@ -14,6 +14,7 @@ import math
 import os
 import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 
@@ -278,7 +279,7 @@ def _cmd_sweep(args):
     else:
         options.update(intervals=args.intervals, degree=args.degree, t_max=args.t_max,
                        weights=parse_weights(args.weights) if args.weights is not None else None,
-                       warm_start=not args.cold, verify=not args.no_verify)
+                       warm_start=not args.cold, verify=not args.no_verify, reuse_problem=not args.model_per_point)
     summary = run_sweep(args.scene, args.out, task=args.task, grid=args.grid, samples=args.samples,
                         seed=args.seed, uncertain=args.uncertain,
                         overrides=dict(parse_override(text) for text in args.set), options=options,
@@ -409,8 +410,9 @@ def build_parser():
     p.add_argument("--output-points", type=count(2, 200_000, "output times per run"), default=None,
                    help="simulate: output times per run (default: the scene's simulation.output_points)")
     p.add_argument("--model-per-point", action="store_true",
-                   help="simulate: build a new model at every point (the single-run results bit for bit; "
-                        "default: one model per worker with the swept fields as parameters, where possible)")
+                   help="build a new model (simulate: the single-run results bit for bit) or collocation problem "
+                        "(optimize) at every point (default: one per worker with the swept fields as parameters, "
+                        "where possible)")
     p.add_argument("--native", default="auto", choices=("auto", "on", "off"),
                    help="simulate: compiled C code: auto (default) for a model reused over the points, where "
                         "a C compiler exists; on: also for one model per point (1-4 s each); off: never")

@@ -189,6 +189,7 @@ def test_an_optimize_chain_warm_starts_and_finds_the_cold_optimum(tmp_path):
     rows = read_rows(tmp_path / "s")
     assert [r["status"] for r in rows] == ["ok", "ok"]
     assert [r["warm_start"] for r in rows] == [False, True]
+    assert [r["problem_reused"] for r in rows] == [True, True]            # one problem for both points
     scene = load_scene("default_driveline", overrides=dict(EQUAL_SPLIT, **{"load.torque": rows[1]["load.torque"]}))
     cold = EngagementOCP(scene, intervals=12).solve()
     # the same optimum (measured: warm and cold agree to 1e-14; IPOPT's tolerance allows more)
@@ -214,3 +215,35 @@ def test_samples_are_the_seeded_draws_of_the_scene_uncertainty(tmp_path):
     assert [r["actuation.time_constant"] for r in rows] == [d["actuation.time_constant"] for d in draws]
     assert summary["fields"] == ["actuation.time_constant"] and summary["points_ok"] == 3
     assert (tmp_path / "s" / "sample_histograms.png").is_file() and (tmp_path / "s" / "sample_scatter.png").is_file()
+
+
+def test_the_sweep_command_writes_its_folder_and_says_so(tmp_path, capsys):
+    code = main(["sweep", "zhang2021", "--grid", "oil.viscosity=0.04:0.06:2", "--out", str(tmp_path / "s"),
+                 "--engine", "serial", "--native", "off"])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert f"wrote {tmp_path / 's'}: sweep_lines.png, summary.json, results.csv" in out
+
+
+def test_model_per_point_gives_each_optimize_point_its_own_problem(tmp_path):
+    code = main(["sweep", "default_driveline", "--task", "optimize", "--grid", "load.torque=100:100:1",
+                 "--set", f"roughness.sigma_1={EQUAL_SPLIT['roughness.sigma_1']}",
+                 "--set", f"roughness.sigma_2={EQUAL_SPLIT['roughness.sigma_2']}",
+                 "--intervals", "8", "--no-verify", "--engine", "serial", "--model-per-point",
+                 "--out", str(tmp_path / "s")])
+    assert code == 0
+    assert [r["problem_reused"] for r in read_rows(tmp_path / "s")] == [False]
+
+
+def test_ctrl_c_while_the_figures_are_drawn_says_that_every_point_is_kept(tmp_path, monkeypatch):
+    import clutchocp.study.run as study_run
+    from clutchocp.study import StudyInterrupted
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(study_run, "draw_study", interrupted)
+    with pytest.raises(StudyInterrupted, match="interrupted after 2 of 2 points; the finished points are kept"):
+        run_sweep("zhang2021", tmp_path / "s", grid=["oil.viscosity=0.04:0.06:2"], engine="serial", progress=False,
+                  options={"native": False})
+    assert len(read_rows(tmp_path / "s")) == 2 and not (tmp_path / "s" / LOCK).exists()

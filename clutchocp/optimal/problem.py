@@ -653,7 +653,7 @@ class EngagementOCP:
         lbg, ubg = nlp.lbg.copy(), nlp.ubg.copy()
         ubg[nlp.rows["total_time"]] = t_upper / sc.time_s
         ubg[nlp.end_rows(len(nlp.parts) - 1).stop - 1] = e_max / sc.energy_J if e_max is not None else np.inf
-        p = [weights[k] for k in OBJECTIVE_TERMS]
+        p = self.parameter_values(weights)
         solver = self.solver(warm)
         start = time.perf_counter()
         with interrupt.in_solver():
@@ -668,6 +668,11 @@ class EngagementOCP:
                               np.array(sol["lam_g"]).ravel(), float(sol["f"]), weights, stats)
         result.t_max, result.e_max = t_max, e_max
         return result
+
+    def parameter_values(self, weights):
+        """The NLP parameter vector of a solve: the objective weights (a subclass with scene values
+        as parameters, :mod:`clutchocp.study.parametric_ocp`, appends them)."""
+        return [weights[k] for k in OBJECTIVE_TERMS]
 
     def _failure_message(self, stats, t_max):
         status = stats["status"]

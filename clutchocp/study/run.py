@@ -9,7 +9,7 @@ from ..errors import ModelError
 from ..output import write_summary
 from ..scene import load_scene
 from ..simulation.native import native_status
-from .executor import check_engine, default_workers, execute
+from .executor import StudyInterrupted, check_engine, default_workers, execute
 from .figures import draw_study
 from .folder import StudyFolder
 from .points import StudySpecError, chains, grid_points, parse_grid, point_id
@@ -116,10 +116,13 @@ def run_sweep(scene, out_dir, *, task="simulate", grid=(), samples=None, seed=0,
         rows = folder.finished()
         order = {point_id(p): k for k, p in enumerate(points)}
         rows = sorted((r for r in rows if r["point_id"] in order), key=lambda r: order[r["point_id"]])
-        summary = sweep_summary(base, job, fields, rows, resumed=len(done & set(order)), computed=len(todo),
-                                wall=wall, engine_info=engine_info, samples=samples, seed=seed)
-        files = draw_study(out, base, job, fields, rows, samples is not None)
-        files.append(write_summary(out / "summary.json", summary))
+        try:
+            summary = sweep_summary(base, job, fields, rows, resumed=len(done & set(order)), computed=len(todo),
+                                    wall=wall, engine_info=engine_info, samples=samples, seed=seed)
+            files = draw_study(out, base, job, fields, rows, samples is not None)
+            files.append(write_summary(out / "summary.json", summary))
+        except KeyboardInterrupt:         # Ctrl-C while drawing: every row is written, say so
+            raise StudyInterrupted(len(rows), len(points)) from None
     summary["files"] = [str(f) for f in files]
     return summary
 

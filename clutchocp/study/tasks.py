@@ -27,12 +27,13 @@ SIMULATE_COLUMNS = SIMULATE_RESULTS + ("n_steps", "model_reused", "native_code",
                                        "run_time_s")
 OPTIMIZE_COLUMNS = ("engagement_time_s", "t_max_s", "jerk_integral", "dissipated_energy_J", "lockup_torque_jump_Nm",
                     "peak_jerk_rad_s3", "peak_torque_Nm", "objective", "ipopt_iterations", "solve_time_s",
-                    "build_time_s", "warm_start", "idas_lock_time_rel_diff", "run_time_s")
+                    "build_time_s", "warm_start", "problem_reused", "idas_lock_time_rel_diff", "run_time_s")
 STATUS_COLUMNS = ("point_id", "status", "reason")
 # Options of each task with their defaults (see Task).
 DEFAULT_OPTIONS = {
     "simulate": {"output_points": None, "rtol": None, "atol": None, "native": "auto", "reuse_model": True},
-    "optimize": {"intervals": 40, "degree": 3, "t_max": None, "weights": None, "warm_start": True, "verify": True},
+    "optimize": {"intervals": 40, "degree": 3, "t_max": None, "weights": None, "warm_start": True, "verify": True,
+                 "reuse_problem": True},
 }
 
 
@@ -63,7 +64,10 @@ class Task:
         model per point, bit for bit the single-run results), ``native`` (``"auto"``, default:
         compiled C for a reused model where a C compiler exists; True: for every model; False: never). optimize: ``intervals``, ``degree``, ``t_max`` [s] (None: each
         point's own baseline lock time), ``weights``, ``warm_start`` (bool, default True),
-        ``verify`` (bool, default True: replay each optimum with IDAS). Missing options take the
+        ``verify`` (bool, default True: replay each optimum with IDAS), ``reuse_problem`` (bool,
+        default True: one collocation problem per worker with the swept fields as parameters,
+        :mod:`clutchocp.study.parametric_ocp`, where the problem allows it; False: a new problem
+        per point). Missing options take the
         defaults of :data:`DEFAULT_OPTIONS`.
     """
 
@@ -119,6 +123,24 @@ def run_unit(task, points):
     if task.kind == "simulate":
         return [simulate_point(task, point) for point in points]
     return optimize_chain(task, points)
+
+
+def warm_up(task, units):
+    """Prepare this process to hand its state to forked workers: run the first point of a simulate
+    study here (it builds the reused model, checks it and compiles its code, see
+    :func:`simulate_point`); an optimize study is left as it is.
+
+    Returns
+    -------
+    done : list of (dict, dict or None)
+        The results of the points run here.
+    units : list of list of dict
+        The units still to run.
+    """
+    if task.kind != "simulate" or not units:
+        return [], units
+    first, rest = units[0][:1], [units[0][1:]] + list(units[1:])
+    return run_unit(task, first), [u for u in rest if u]
 
 
 def simulate_point(task, point):
@@ -198,16 +220,52 @@ def optimize_chain(task, points):
     return out
 
 
+_PROBLEMS = {}          # this worker's reused optimize problems: key -> SweepOCP or None
+
+
+def clear_caches():
+    """Forget this process's reused models and problems and loaded scenes (a benchmark times
+    their build this way)."""
+    _PARAMETRIC.clear()
+    _PROBLEMS.clear()
+    _base_scene.cache_clear()
+
+
+def _problem(task, point, scene):
+    """The problem of ``point``: this worker's reused problem set to the point, or a new one.
+
+    Returns ``(ocp, reused)``."""
+    from ..optimal.problem import EngagementOCP
+    from . import parametric_ocp
+
+    opts = task.options
+    settings = {"intervals": opts["intervals"], "degree": opts["degree"]}
+    names = tuple(sorted(point))
+    if opts["reuse_problem"] and names and all(isinstance(point[n], float) for n in names):
+        key = (task.scene, tuple(sorted(task.base_overrides.items(), key=lambda kv: kv[0])), names)
+        if key not in _PROBLEMS:                  # built at its first point: ready for it
+            _PROBLEMS[key] = parametric_ocp.build(scene, names, **settings)
+            if _PROBLEMS[key] is not None:
+                return _PROBLEMS[key], True
+        ocp = _PROBLEMS[key]
+        if ocp is not None:
+            try:
+                ocp.set_point(scene)
+                return ocp, True
+            except parametric_ocp.NotReusable:
+                pass
+    return EngagementOCP(scene, **settings), False
+
+
 def optimize_point(task, point, guess=None):
     """Solve one point; returns ``(row, curve, optimum)`` (``curve`` and ``optimum`` None on failure)."""
-    from ..optimal.problem import EngagementOCP
     from ..optimal.verify import verify
 
     opts = task.options
     start = time.perf_counter()
     try:
         scene = point_scene(task, point)
-        ocp = EngagementOCP(scene, intervals=opts["intervals"], degree=opts["degree"])
+        ocp, reused = _problem(task, point, scene)
         built = time.perf_counter()
         try:
             optimum = ocp.solve(t_max=opts["t_max"], weights=opts["weights"], guess=guess)
@@ -221,7 +279,7 @@ def optimize_point(task, point, guess=None):
                                                        "objective")}
         numbers.update(t_max_s=float(optimum.t_max), ipopt_iterations=int(optimum.stats["iterations"]),
                        solve_time_s=float(optimum.stats["wall_time_s"]), build_time_s=built - start,
-                       warm_start=bool(optimum.stats["warm_start"]))
+                       warm_start=bool(optimum.stats["warm_start"]), problem_reused=reused)
         if opts["verify"]:
             check, _ = verify(ocp.exact if ocp.polish else ocp, optimum)
             numbers["idas_lock_time_rel_diff"] = check["lock_time_rel_diff"]

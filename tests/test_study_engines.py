@@ -1,0 +1,64 @@
+"""The engines of a sweep: batches of points, forked local workers and a LocalCluster started by the sweep."""
+
+import csv
+
+import pytest
+
+from clutchocp.study import run_sweep
+from clutchocp.study.executor import batches, start_method
+from clutchocp.study.folder import RESULTS
+
+GRID = ["actuation.pressure=0.4 MPa:0.8 MPa:2", "oil.viscosity=0.04:0.06:3"]
+TIMING = ("build_time_s", "integration_time_s", "run_time_s")               # wall-clock, not results
+
+
+def _rows(folder):
+    with (folder / RESULTS).open(newline="") as fh:
+        return {r["point_id"]: {k: v for k, v in r.items() if k not in TIMING} for r in csv.DictReader(fh)}
+
+
+@pytest.fixture(scope="module")
+def serial_rows(tmp_path_factory):
+    out = tmp_path_factory.mktemp("serial") / "s"
+    run_sweep("zhang2021", out, grid=GRID, engine="serial", progress=False, options={"native": False})
+    return _rows(out)
+
+
+@pytest.mark.parametrize("n_units, workers", [(200, 2), (19, 2), (7, 4), (1, 8), (0, 2)])
+def test_batches_keep_every_unit_once_in_order_and_shrink_to_single_units(n_units, workers):
+    units = [[{"k": float(i)}] for i in range(n_units)]
+    parts = batches(units, workers)
+    assert [u for part in parts for u in part] == units
+    sizes = [len(p) for p in parts]
+    assert all(sizes) and sizes == sorted(sizes, reverse=True)
+    if n_units:
+        assert sizes[0] == -(-n_units // (4 * workers)) and sizes[-1] == 1
+    if n_units == 200:                    # 25, 22, 20, 17 ... 1: 29 messages instead of 200
+        assert sizes[:4] == [25, 22, 20, 17] and len(parts) < 50
+
+
+def test_local_workers_give_the_rows_of_a_serial_sweep(tmp_path, serial_rows):
+    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID, engine="local", workers=2, progress=False,
+                        options={"native": False})
+    assert summary["engine"]["start_method"] == start_method()
+    rows = _rows(tmp_path / "s")
+    assert rows == serial_rows                                       # the same text, to the last digit
+    assert all(r["model_reused"] == "true" for r in rows.values())
+
+
+def test_a_dask_local_cluster_started_by_the_sweep_gives_the_rows_of_a_serial_sweep(tmp_path, serial_rows):
+    pytest.importorskip("distributed")
+    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID, engine="dask", workers=2, progress=False,
+                        options={"native": False})
+    assert summary["engine"]["engine"] == "dask" and summary["engine"]["workers"] == 2
+    assert _rows(tmp_path / "s") == serial_rows
+
+
+def test_spawned_workers_where_fork_is_not_used_give_the_same_rows(tmp_path, serial_rows, monkeypatch):
+    from clutchocp.study import executor
+
+    monkeypatch.setattr(executor, "start_method", lambda: "spawn")       # as on macOS and Windows
+    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID, engine="local", workers=2, progress=False,
+                        options={"native": False})
+    assert summary["engine"]["start_method"] == "spawn" and summary["engine"]["workers"] == 2
+    assert _rows(tmp_path / "s") == serial_rows

@@ -87,3 +87,25 @@ def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch)
     assert facts["closed_loop"]["feedforward"] == "robust_feedforward"
     assert len(seen["scenarios"]) == 9                       # 2^3 corners and the centre
     assert facts["robust_feedforward"]["stats"] == {"status": "stand-in"}
+
+
+def test_closed_loop_tracks_a_feedforward_with_a_time_margin_when_asked(monkeypatch):
+    """feedforward.t_max_fraction < 1 (no robust feedforward): the nominal optimum strategy keeps t_max,
+    the closed loop tracks an optimum that locks at that fraction of t_max on the nominal clutch."""
+    from dataclasses import replace
+
+    from clutchocp.shiftcontrol import report
+    from clutchocp.shiftcontrol.spec import load_slip_spec
+
+    monkeypatch.setattr(report, "robust_solver", lambda: None)
+    scene = default_scene()
+    spec = replace(load_slip_spec(), t_max_fraction=0.9)
+    strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene), spec,
+                                                intervals=30, say=lambda *a: None)
+    t_max = facts["t_max_s"]
+    assert [s.name for s in strategies] == ["baseline", "nominal_optimum", "closed_loop"]
+    assert strategies[1].notes["t_lock_s"] == pytest.approx(t_max, rel=1e-6)
+    assert facts["closed_loop"]["feedforward"] == "nominal_optimum_with_margin"
+    assert "0.9 x t_max" in strategies[2].label
+    # the IDAS replay of the tighter optimum locks where the collocation put it, within the lock-time tolerance
+    assert facts["closed_loop"]["nominal_lock_s"] == pytest.approx(0.9 * t_max, rel=0.01)

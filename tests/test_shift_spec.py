@@ -15,6 +15,8 @@ def test_builtin_spec_loads_with_units():
     assert spec.max_delay == pytest.approx(0.05)
     assert spec.anti_windup == "clamping" and spec.progress == "slip"
     assert spec.lqi["slip_tolerance"] == pytest.approx(0.003)
+    assert spec.t_max_fraction == 1.0
+    assert parse_slip_spec({**GOOD, "feedforward": {"t_max_fraction": 0.85}}).t_max_fraction == pytest.approx(0.85)
 
 
 @pytest.mark.parametrize("raw, match", [
@@ -29,6 +31,9 @@ def test_builtin_spec_loads_with_units():
     ({"controller": {**GOOD["controller"], "pressure_min": "1 MPa", "pressure_max": "0.5 MPa"}},
      r"pressure_min = 1e\+06 Pa must be below"),
     ({"controller": {**GOOD["controller"], "progress": "speed"}}, r"controller\.progress = 'speed': allowed values are slip, time"),
+    ({**GOOD, "feedforward": {"t_max_fraction": 1.2}}, r"feedforward\.t_max_fraction = 1\.2: must be in \(0, 1\]"),
+    ({**GOOD, "feedforward": {"t_max_fraction": 0}}, r"feedforward\.t_max_fraction = 0: must be > 0"),
+    ({**GOOD, "feedforward": {"t_max_fracton": 0.9}}, r"feedforward\.t_max_fracton: unknown key .*did you mean 't_max_fraction'"),
 ])
 def test_bad_specs_raise_one_line(raw, match):
     with pytest.raises(SceneError, match=match) as info:

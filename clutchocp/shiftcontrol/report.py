@@ -106,11 +106,21 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
                                        "lock_times_s": [float(s.t_f) for s in rob.scenarios],
                                        "stats": {k: v for k, v in rob.stats.items()
                                                  if isinstance(v, (bool, int, float, str))}}
-    say(f"  slip feedback on the {feedforward[0].replace('_', ' ')}: {spec.label}, Ts = {spec.sample_time * 1e3:g} ms")
+    if rob is None and spec.t_max_fraction < 1.0:
+        # no robust feedforward: the loop tracks a nominal optimum that locks with a time margin, so that
+        # a slower clutch can still lock within t_max (feedforward.t_max_fraction of the spec)
+        t_ff = spec.t_max_fraction * t_max
+        say(f"  nominal optimum for the closed loop at {spec.t_max_fraction:g} x t_max = {t_ff:.4g} s")
+        tight = ocp.solve(t_max=t_ff, guess=opt)
+        feedforward = ("nominal_optimum_with_margin", tight.command_times, tight.command)
+    ff_label = feedforward[0].replace("_", " ") + (f" ({spec.t_max_fraction:g} x t_max)"
+                                                   if feedforward[0] == "nominal_optimum_with_margin" else "")
+    say(f"  slip feedback on the {ff_label}: {spec.label}, Ts = {spec.sample_time * 1e3:g} ms")
     design = design_slip_feedback(scene, feedforward[1], feedforward[2], spec)
-    strategies.append(Strategy("closed_loop", f"slip feedback on {feedforward[0].replace('_', ' ')}",
+    strategies.append(Strategy("closed_loop", f"slip feedback on {ff_label}",
                                feedback=design.feedback, notes={"feedforward": feedforward[0]}))
-    facts["closed_loop"] = {"feedforward": feedforward[0], "controller": spec.label,
+    facts["closed_loop"] = {"feedforward": feedforward[0], "feedforward_t_max_fraction": spec.t_max_fraction,
+                            "controller": spec.label,
                             "sample_time_s": spec.sample_time, "nominal_lock_s": design.t_lock,
                             "progress": spec.progress, "measured": list(design.feedback.measured)}
     return strategies, facts
@@ -191,6 +201,7 @@ def run_robust(scene=None, out_dir="out/robust", *, samples=200, seed=0, uncerta
                    "workers": workers or _cpu_count()},
         "controller": {"name": spec.label, "sample_time_s": spec.sample_time, "lqi": spec.lqi,
                        "anti_windup": spec.anti_windup, "progress": spec.progress,
+                       "feedforward_t_max_fraction": spec.t_max_fraction,
                        "measure_pressure": spec.measure_pressure, "rate_limit_time_s": spec.rate_limit_time},
     }
     out = Path(out_dir)

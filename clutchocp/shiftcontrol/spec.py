@@ -22,6 +22,9 @@ field::
 
     [anti_windup]
     method = "clamping"              # or "none"
+
+    [feedforward]                    # without a robust feedforward: the nominal optimum the loop tracks
+    t_max_fraction = 1.0             # is solved with t_max x this, so it locks with a time margin
 """
 
 from dataclasses import dataclass, field
@@ -55,7 +58,8 @@ _LQI = {
     "terminal_weight": ("1", "nonnegative", 10.0),
 }
 _ANTI_WINDUP = {"method": ("choice", ANTI_WINDUP, "clamping")}
-_TABLES = {"controller": _CONTROLLER, "lqi": _LQI, "anti_windup": _ANTI_WINDUP}
+_FEEDFORWARD = {"t_max_fraction": ("1", "positive", 1.0)}
+_TABLES = {"controller": _CONTROLLER, "lqi": _LQI, "anti_windup": _ANTI_WINDUP, "feedforward": _FEEDFORWARD}
 _REQUIRED = ("type", "sample_time")
 
 
@@ -74,6 +78,7 @@ class SlipControlSpec:
     max_delay: float = 0.05
     lqi: dict = field(default_factory=lambda: {k: v[2] for k, v in _LQI.items()})
     anti_windup: str = "clamping"
+    t_max_fraction: float = 1.0
     path: Path | None = None
 
     @property
@@ -112,9 +117,13 @@ def parse_slip_spec(raw):
     if c["pressure_min"] is not None and c["pressure_max"] is not None and c["pressure_min"] >= c["pressure_max"]:
         raise PhysicalRangeError(f"controller.pressure_min = {c['pressure_min']:g} Pa must be below "
                                  f"controller.pressure_max = {c['pressure_max']:g} Pa")
+    fraction = values["feedforward"]["t_max_fraction"]
+    if fraction > 1.0:
+        raise PhysicalRangeError(f"feedforward.t_max_fraction = {fraction:g}: must be in (0, 1] (the closed loop's "
+                                 "feedforward locks at this fraction of t_max or earlier)")
     weights = values["lqi"]
     return SlipControlSpec(sample_time=c["sample_time"], name=c["name"], description=c["description"],
                            pressure_min=c["pressure_min"], pressure_max=c["pressure_max"],
                            rate_limit_time=c["rate_limit_time"], measure_pressure=c["measure_pressure"],
                            progress=c["progress"], max_delay=c["max_delay"],
-                           lqi=weights, anti_windup=values["anti_windup"]["method"])
+                           lqi=weights, anti_windup=values["anti_windup"]["method"], t_max_fraction=fraction)

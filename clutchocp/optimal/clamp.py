@@ -50,13 +50,14 @@ class ClampedCommand:
 
     ``times`` [s] and ``pressures`` [Pa] are piecewise linear between the points and the last value
     holds afterwards; the ramp to ``clamp_pressure_Pa`` runs from ``ramp_start_s`` (lock-up) to
-    ``ramp_end_s`` at ``rate_limit_Pa_s``; ``margin`` = settled static capacity / ``locked_torque_Nm``.
+    ``ramp_end_s`` at ``rate_limit_Pa_s``; ``margin`` = settled static capacity / ``locked_torque_Nm``
+    (None for a clamp pressure given rather than sized: a lock that carries no torque).
     """
 
     times: np.ndarray
     pressures: np.ndarray
     clamp_pressure_Pa: float
-    margin: float
+    margin: float | None
     locked_torque_Nm: float
     ramp_start_s: float
     ramp_end_s: float
@@ -156,7 +157,7 @@ class ClampModel:
 
 
 def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MARGIN, rate_limit=None,
-                    locked_torque=None):
+                    locked_torque=None, clamp_pressure=None):
     """The engagement command up to lock-up continued by a ramp to the clamp pressure.
 
     Parameters
@@ -172,6 +173,10 @@ def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MAR
         Ramp rate [Pa/s] (default: actuation.max_pressure per 10 ms, the optimisation's default).
     locked_torque : float, optional
         Torque the locked driveline carries [N m] (default: from the model, both sides at the output speed).
+    clamp_pressure : float, optional
+        The pressure to ramp to [Pa], given instead of sized by ``margin``: for a lock that carries no
+        torque (a brake with its output held, a prescribed input speed without load), which no
+        capacity margin can size; the ClampedCommand's margin is then None.
 
     Returns
     -------
@@ -186,7 +191,7 @@ def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MAR
     if not (np.isfinite(t_lock) and times[0] < t_lock):
         raise ModelError(f"t_lock = {t_lock!r}: must be a time after the command starts [s]")
     clamp = ClampModel(scene)
-    p_c = clamp.clamp_pressure(margin, locked_torque)
+    p_c = clamp.clamp_pressure(margin, locked_torque) if clamp_pressure is None else float(clamp_pressure)
     rate = clamp.p_max / 0.01 if rate_limit is None else float(rate_limit)
     if not (np.isfinite(rate) and rate > 0):
         raise ModelError(f"rate_limit = {rate_limit!r}: must be a positive rate [Pa/s]")
@@ -196,4 +201,5 @@ def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MAR
     out_t = np.concatenate([times[keep], [t_lock], [t_end] if t_end > t_lock else []])
     out_p = np.concatenate([values[keep], [p_lock], [p_c] if t_end > t_lock else []])
     demand = abs(clamp.locked_torque() if locked_torque is None else float(locked_torque))
-    return ClampedCommand(out_t, out_p, p_c, margin, demand, float(t_lock), float(t_end), rate)
+    return ClampedCommand(out_t, out_p, p_c, margin if clamp_pressure is None else None, demand, float(t_lock),
+                          float(t_end), rate)

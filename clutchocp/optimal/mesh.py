@@ -19,6 +19,7 @@ factor 2, then a floor on rho (a tenth of its mean, so no interval grows beyond 
 import casadi as ca
 import numpy as np
 
+from ..errors import SolverError
 from .problem import OBJECTIVE_TERMS
 
 ORDER_OVER_DEGREE = 1           # q = degree + 1
@@ -115,7 +116,8 @@ def solve_verified(ocp, *, refinements=MAX_REFINEMENTS, command_model=None, say=
     Each refinement grades every phase's mesh from the optimum's interval defects
     (:meth:`~clutchocp.optimal.problem.EngagementOCP.refined`, same number of intervals) and solves
     again from that optimum (its states and command interpolated onto the new mesh). The result is
-    the last solve; it stops early once the IDAS replay passes.
+    the last solve; it stops early once the IDAS replay passes. A solve on a graded mesh that fails
+    (IPOPT) ends the refinement with the previous optimum, and the history records the failure.
 
     Parameters
     ----------
@@ -135,7 +137,8 @@ def solve_verified(ocp, *, refinements=MAX_REFINEMENTS, command_model=None, say=
         ``ocp`` (the problem of the last solve), ``optimum``, ``check`` and ``replay`` (its
         verification, :func:`clutchocp.optimal.verify.verify`) and ``history``: per solve its
         mesh (smallest and largest interval [s] of each phase), IPOPT iterations and wall time [s],
-        objective, and the verification's lock-time difference and jump share.
+        objective, and the verification's lock-time difference and jump share (a failed solve:
+        ``{"graded": True, "failed": message}``).
     """
     from .verify import verify
     say = say or (lambda *a, **k: None)
@@ -155,10 +158,76 @@ def solve_verified(ocp, *, refinements=MAX_REFINEMENTS, command_model=None, say=
             return {"ocp": ocp, "optimum": opt, "check": check, "replay": replay, "history": history}
         say(f"  IDAS replay off (lock-up {_pct(check['lock_time_rel_diff'])} from the collocation's, jump "
             f"{_pct(check['torque_jump_rel'])}): grading the mesh from the interval defects and solving again")
-        ocp = ocp.refined(opt)
-        kwargs = dict(solve_kwargs, guess=opt)
-        opt = ocp.solve(**kwargs)
+        refined = ocp.refined(opt)
+        try:
+            opt_new = refined.solve(**dict(solve_kwargs, guess=opt))
+        except SolverError as exc:         # keep the last optimum; its check says it missed
+            say(f"  the solve on the graded mesh failed ({exc}); keeping the previous optimum")
+            history.append({"graded": True, "failed": str(exc)})
+            return {"ocp": ocp, "optimum": opt, "check": check, "replay": replay, "history": history}
+        ocp, opt = refined, opt_new
 
 
 def _pct(value):
     return "none" if value is None else f"{100 * value:.3g} %"
+
+
+def collocation_step_errors(fn, tr, x_nodes, u, T, params):
+    """Local error of one collocation step on each interval along a given trajectory.
+
+    Each interval k is solved on its own as the collocation method would (the d collocation equations
+    of :mod:`clutchocp.optimal.collocation` from the node state x_k under the command, Newton's
+    method), and its end state is compared with an accurate integration (CVODES, tolerance
+    ``DEFECT_TOL``) from the same x_k. Along a simulated run (the initial guess) this measures how
+    well the mesh resolves that run before any optimisation.
+
+    Parameters
+    ----------
+    fn : casadi.Function
+        Phase dynamics ``(x, u, p) -> (xdot, q, c)`` (scaled; per unit scaled time).
+    tr : clutchocp.optimal.collocation.DirectCollocation
+    x_nodes : array (N + 1, n_x)
+        Scaled states at the interval starts (the last row unused).
+    u : array (n_controls,)
+        Scaled command values (N + 1 for a linear command, N for a constant one).
+    T : float
+        Scaled phase duration.
+    params : array
+        The NLP parameter vector (weights).
+
+    Returns
+    -------
+    ndarray (N,)
+        max_i |x_colloc,i(t_k+1) - x_i(t_k+1)| per interval (scaled); 1e3 where Newton fails.
+    """
+    N, d = tr.intervals, tr.degree
+    n_x = fn.size1_in(0)
+    xk, Xc = ca.SX.sym("xk", n_x), ca.SX.sym("Xc", n_x, d)
+    uL, uR, h = ca.SX.sym("uL"), ca.SX.sym("uR"), ca.SX.sym("h")
+    p = ca.SX.sym("p", fn.size1_in(2))
+    nodes = [xk] + [Xc[:, j] for j in range(d)]
+    residual = []
+    for j in range(d):
+        uj = uL + (uR - uL) * tr.tau[j]
+        slope = sum(tr.C[r, j] * nodes[r] for r in range(d + 1))
+        residual.append(slope - h * fn(Xc[:, j], uj, p)[0])
+    end = sum(tr.D[r] * nodes[r] for r in range(d + 1))
+    pk = ca.vertcat(xk, uL, uR, h, p)
+    rf = ca.rootfinder("collocation_step", "newton", {"x": ca.vec(Xc), "p": pk, "g": ca.vertcat(*residual)},
+                       {"error_on_fail": False, "max_iter": 100, "abstol": 1e-12})
+    Xc_sol = rf(ca.repmat(xk, d, 1), pk)
+    step = ca.Function("step", [xk, uL, uR, h, p], [ca.substitute(end, ca.vec(Xc), Xc_sol)])
+    s = ca.SX.sym("s")
+    dae = {"x": xk, "t": s, "p": pk[n_x:], "ode": h * fn(xk, uL + (uR - uL) * s, p)[0]}
+    integrator = ca.integrator("reference_step", "cvodes", dae, 0.0, 1.0,
+                               {"abstol": DEFECT_TOL, "reltol": DEFECT_TOL, "max_num_steps": 100000})
+    u = np.asarray(u, float).ravel()
+    u_left = u[:N]
+    u_right = u[1:N + 1] if tr.control == "linear" else u[:N]
+    steps = tr.steps(T)
+    P = np.repeat(np.asarray(params, float)[:, None], N, axis=1)
+    x0 = np.asarray(x_nodes, float)[:N].T
+    colloc = np.array(step.map(N)(x0, u_left[None, :], u_right[None, :], steps[None, :], P))
+    exact = np.array(integrator.map(N)(x0=x0, p=np.vstack([u_left, u_right, steps, P]))["xf"])
+    err = np.max(np.abs(colloc - exact), axis=0)
+    return np.where(np.isfinite(err), err, 1e3)

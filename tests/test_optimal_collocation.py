@@ -234,3 +234,4 @@ def test_graded_mesh_guards_keep_it_regular():
     in_second = np.sum((nodes >= 1.0 / N) & (nodes < 2.0 / N))
     assert in_second == pytest.approx(np.sum(nodes < 1.0 / N) / 2, abs=1)
     assert new.max() <= (1 + DENSITY_FLOOR) / (N * DENSITY_FLOOR) * (1 + 1e-12)
+

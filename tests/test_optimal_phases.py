@@ -273,3 +273,43 @@ def test_spring_applied_bao2020_optimum_is_confirmed_by_idas():
     assert abs(check["torque_jump_Nm"]) <= 0.02 * check["idas"]["peak_torque_Nm"]
     assert check["holding_pressure_Pa"] == 0.0                  # after lock-up the spring clamps
     assert check["idas"]["kiss_speed_m_s"] == pytest.approx(opt.terms["kiss_speed_m_s"], rel=1e-4)
+
+
+ENGAGEMENT_SCENES = ("bao2020", "bao2020_as_published", "default_driveline", "default_driveline_thermal",
+                     "default_fill", "zhang2021")
+
+
+def test_every_engagement_scene_is_listed_and_carries_a_pressure_limit():
+    from clutchocp.scene import list_scenes
+    assert sorted(s.name for s in list_scenes() if s.kind == "engagement") == sorted(ENGAGEMENT_SCENES)
+    for name in ENGAGEMENT_SCENES:
+        assert load_scene(name).get("actuation.max_pressure") is not None, name
+    assert load_scene("zhang2021").value("actuation.max_pressure") == 6e5          # Zhang Table 1, P_o
+
+
+@pytest.mark.parametrize("name", ["bao2020", "bao2020_as_published"])
+def test_bao_starts_held_released_by_the_pressure_that_balances_the_preload(name):
+    """initial_pressure x area = spring rate x preload (Bao Eq. 21 at x0 = 0 is zero): the piston
+    starts at rest; the limit leaves a margin above it."""
+    scene = load_scene(name)
+    k = scene.value("piston.spring_stiffness") * scene.value("piston.spring_count")
+    balance = k * scene.value("piston.spring_preload") / scene.value("piston.area")
+    assert scene.value("actuation.initial_pressure") == pytest.approx(balance, rel=1e-4)
+    assert scene.value("actuation.max_pressure") >= 1.2 * balance
+    from clutchocp.engagement.model import EngagementModel
+    model = EngagementModel(scene)
+    assert float(model.drive_force(scene.value("actuation.initial_pressure"), 0.0)) == pytest.approx(0.0, abs=10.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ENGAGEMENT_SCENES)
+def test_optimize_succeeds_on_every_engagement_scene(name, tmp_path):
+    """The done-when of the phased optimiser: no --set, the IDAS replay within its tolerances, no NaN."""
+    import json
+    assert main(["optimize", name, "--out", str(tmp_path / name)]) == 0
+    text = (tmp_path / name / "summary.json").read_text(encoding="utf-8")
+    assert "NaN" not in text and "Infinity" not in text
+    summary = json.loads(text)
+    assert summary["verification"]["passed"]
+    assert summary["verification"]["lock_time_rel_diff"] <= 0.01
+    assert summary["verification"]["torque_jump_rel"] <= 0.02

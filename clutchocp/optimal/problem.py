@@ -266,11 +266,11 @@ class EngagementOCP:
         if start_mode not in (SLIP_MODE, FILL_MODE):
             raise ModelError(f"scene '{scene.name}' starts in mode '{start_mode}'; the optimisation covers an "
                              f"engagement that starts slipping forward (driveline.input_speed > output_speed)")
-        meshes = meshes or {}
-        self.transcription = transcription or DirectCollocation(intervals, degree, scheme, control,
-                                                                mesh=meshes.get("slip"))
+        meshes = dict(meshes or {})
         # Phases (name, mode): the fill phase first if the piston starts with free travel.
         self.phase_modes = ([("fill", FILL_MODE)] if start_mode == FILL_MODE else []) + [("slip", SLIP_MODE)]
+        self.transcription = transcription or DirectCollocation(intervals, degree, scheme, control,
+                                                                mesh=meshes.get("slip"))
         self.fill_transcription = DirectCollocation(fill_intervals, degree, scheme, control, mesh=meshes.get("fill")) \
             if start_mode == FILL_MODE else None
         # Output held (a brake): the braked side is the input; its jerk is the one felt.
@@ -591,12 +591,27 @@ class EngagementOCP:
         from .mesh import graded_mesh, interval_defects
         solved_on = self.exact if self.polish and opt.stats.get("model") == "exact" else self
         defects = interval_defects(solved_on, opt)
-        meshes = {name: graded_mesh(part.transcription.mesh, e, part.transcription.degree)
-                  for (name, _), part, e in zip(self.phase_modes, self.phased.parts, defects)}
+        return self.with_meshes({name: graded_mesh(part.transcription.mesh, e, part.transcription.degree)
+                                 for (name, _), part, e in zip(self.phase_modes, self.phased.parts, defects)})
+
+    def coarsened(self, fraction):
+        """The same problem with ``fraction`` of the slip intervals (equal intervals; the fill phase
+        keeps its mesh); the baseline is shared."""
+        tr = self.transcription
+        options = dict(self.options, meshes=None, intervals=max(2, int(round(fraction * tr.intervals))),
+                       degree=tr.degree, scheme=tr.scheme, control=tr.control)
+        twin = EngagementOCP(self.scene, smooth=self.smooth, polish=self.polish, baseline=self.baseline, **options)
+        twin._fastest = self._fastest
+        return twin
+
+    def with_meshes(self, meshes):
+        """The same problem on other meshes (``{phase name: interval shares}``); the baseline is shared."""
         tr = self.transcription
         options = dict(self.options, meshes=meshes, intervals=tr.intervals, degree=tr.degree, scheme=tr.scheme,
                        control=tr.control)
-        return EngagementOCP(self.scene, smooth=self.smooth, polish=self.polish, baseline=self.baseline, **options)
+        twin = EngagementOCP(self.scene, smooth=self.smooth, polish=self.polish, baseline=self.baseline, **options)
+        twin._fastest = self._fastest
+        return twin
 
     def solve(self, *, t_max=None, e_max=None, weights=None, guess=None):
         """Solve for the optimal command (and polish it on the exact model, see the class notes).

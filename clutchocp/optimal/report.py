@@ -119,7 +119,7 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
     command_model = CommandModel(scene, ocp.transcription.control)
     solved = solve_verified(ocp, t_max=t_max, weights=weights, command_model=command_model, say=say)
     ocp, opt, check, replay = solved["ocp"], solved["optimum"], solved["check"], solved["replay"]
-    graded = sum(h["stage"] == "graded mesh" for h in solved["history"])
+    graded = sum(h["stage"] == "graded mesh" and "failed" not in h for h in solved["history"])
     say(f"  IPOPT {opt.stats['status']}: {opt.stats['iterations']} iterations, {opt.stats['wall_time_s']:.2f} s"
         + (f" (after {graded} mesh refinement(s))" if graded else ""))
     say(f"  IDAS re-simulation: lock-up {_fmt(check['idas']['engagement_time_s'], 's')}, "
@@ -157,7 +157,7 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
                    "lock_margin": ocp.lock_margin},
         "weights": opt.weights,
         "phases": [{k: ph[k] for k in ("name", "mode", "t_start_s", "t_end_s", "intervals")} for ph in opt.phases],
-        "mesh": {"refinements": sum(h["stage"] == "graded mesh" for h in solved["history"]),
+        "mesh": {"refinements": sum(h["stage"] == "graded mesh" and "failed" not in h for h in solved["history"]),
                  "solves": solved["history"]},
         "lockup_definition": _lockup_definition(ocp),
         "clamp": {k: v for k, v in whole.items() if k != "run"},

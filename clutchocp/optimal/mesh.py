@@ -116,9 +116,8 @@ def solve_verified(ocp, *, refinements=MAX_REFINEMENTS, command_model=None, say=
 
     A phased problem (fill and slip) without a ``guess`` is first solved on ``COARSE_FRACTION`` of
     its slip intervals and then on its own mesh from that optimum: on bao2020 a cold solve on 100
-    equal intervals found an optimum of the discretisation error (a 2e3 nominal-value defect in one
-    interval; IDAS locked 6 % later), while 60 intervals and then 100 from there gave an optimum
-    that IDAS confirms (0.02 % and a 0.66 % jump).
+    equal intervals ended at an optimum that IDAS locked 6 % later (one interval's defect 2e3
+    nominal values); 60 intervals and then 100 from there converge to an optimum IDAS confirms.
 
     Each refinement grades every phase's mesh from the optimum's interval defects
     (:meth:`~clutchocp.optimal.problem.EngagementOCP.refined`, same number of intervals) and solves

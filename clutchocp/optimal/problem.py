@@ -492,14 +492,9 @@ class EngagementOCP:
             # with the pressure and let it go, a 20 m/s kiss. A pressure-applied piston gets no bound:
             # its optimum does not move back, and an inactive bound (at 1 or 10 % of the stroke)
             # made IPOPT take 262 or 111 iterations instead of 47 on default_fill.
-            i_x0 = self._names.index("x0")
             if self.apply_pressure == 0.0:
+                i_x0 = self._names.index("x0")
                 x_lb[i_x0] = -0.1 * self.model.travel / self.nominal[i_x0]
-            # The fill mode has no pack: a piston past the kiss point would pass through it. Without
-            # this bound the bao2020_as_published optimum (60 intervals) ran the piston past the pack
-            # and ended the fill on its way back (kiss speed -7.8 m/s at 5.6 ms), while IDAS kissed at
-            # the first crossing (1.7 m/s at 0.85 ms) and locked 8.8 % late.
-            x_ub[i_x0] = self.model.travel / self.nominal[i_x0]
             end_lb, end_ub = np.zeros(1), np.zeros(1)
             if self.jerk_max is not None:
                 end_lb, end_ub = np.array([0.0, -1.0]), np.array([0.0, 1.0])

@@ -125,7 +125,8 @@ def bench_scenes(names, intervals, repeat, json_path=None):
         history = solved["history"]
         ocp.solver(warm=True), ocp.exact.solver(warm=True)
         warm_time, warm = timed_solve(ocp, repeat, t_max=cold.t_max, guess=cold)
-        meshes = {ph: part.transcription.mesh for (ph, _), part in zip(ocp.phase_modes, ocp.phased.parts)}
+        meshes = {ph: part.transcription.mesh for (ph, _), part in zip(ocp.phase_modes, ocp.phased.parts)
+                  if not part.transcription.uniform}
         changed = EngagementOCP(scene.with_overrides({"driveline.input_speed": SPEED_STEP
                                                       * scene.value("driveline.input_speed")}),
                                 intervals=intervals, meshes=meshes)

@@ -712,7 +712,8 @@ class EngagementOCP:
         mine = [part.transcription.mesh for part in self.phased.parts]
         if not opt.meshes:              # an optimum built elsewhere (robust problem): equal intervals
             return all(part.transcription.uniform for part in self.phased.parts)
-        return len(opt.meshes) == len(mine) and all(np.array_equal(a, b) for a, b in zip(opt.meshes, mine))
+        return len(opt.meshes) == len(mine) and all(a.shape == b.shape and np.allclose(a, b, rtol=1e-12, atol=0.0)
+                                                    for a, b in zip(opt.meshes, mine))
 
     def _failure_message(self, stats, t_max):
         status = stats["status"]

@@ -316,3 +316,20 @@ def test_optimize_succeeds_on_every_engagement_scene(name, tmp_path):
     assert summary["verification"]["passed"]
     assert summary["verification"]["lock_time_rel_diff"] <= 0.01
     assert summary["verification"]["torque_jump_rel"] <= 0.02
+
+
+def test_interval_defects_fall_with_the_order_the_grading_assumes():
+    """Halving the mesh of the default scene's optimum divides the median interval defect by about
+    2^q with q = degree + 1 = 4 (measured 19), between the stage order + 1 and the nonstiff local
+    order 2d = 6 of Radau IIA: the defect is a local error of the collocation, measured by CVODES."""
+    from clutchocp.optimal.mesh import ORDER_OVER_DEGREE, interval_defects
+    scene = default_scene()
+    baseline = simulate_engagement(scene)
+    t_max = baseline.summary["engagement_time_s"]
+    medians = []
+    for n in (20, 40):
+        ocp = EngagementOCP(scene, intervals=n, baseline=baseline)
+        opt = ocp.solve(t_max=t_max)
+        medians.append(np.median(interval_defects(ocp.exact, opt)[0]))
+    q = 3 + ORDER_OVER_DEGREE
+    assert 2 ** (q - 0.5) < medians[0] / medians[1] < 2 ** 6

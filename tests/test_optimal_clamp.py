@@ -81,3 +81,28 @@ def test_whole_curve_replayed_holds_the_lock_with_the_margin(scene):
 def test_bad_margins_are_one_clear_line(scene, margin):
     with pytest.raises(ModelError, match="margin"):
         extend_to_clamp(scene, [0.0, 0.1], [1e5, 2e5], 0.1, margin=margin)
+
+
+def test_clamp_with_a_piston_presses_the_pack_with_the_same_face_force():
+    """default_fill is default_driveline with a pressure-applied piston: at its clamp pressure the
+    piston force minus the return spring (at the settled stroke, travel + film closure) equals the
+    face force p A_pack of default_driveline's clamp, and the settled films are the same."""
+    from clutchocp.scene import load_scene
+    fill = ClampModel(load_scene("default_fill"))
+    plain = ClampModel(default_scene())
+    p_fill, p_plain = fill.clamp_pressure(), plain.clamp_pressure()
+    h = fill.settled_films(p_fill)
+    scene, model = fill.model.scene, fill.model
+    k = scene.value("piston.spring_stiffness") * scene.value("piston.spring_count")
+    stroke = model.travel + sum(model.H0 - hi for hi in h)
+    face = p_fill * scene.value("piston.area") - k * (scene.value("piston.spring_preload") + stroke)
+    assert face == pytest.approx(p_plain * plain.model._pack_area(), rel=1e-9)
+    assert np.allclose(h, plain.settled_films(p_plain), rtol=1e-9)
+
+
+def test_a_given_clamp_pressure_needs_no_capacity():
+    """A lock that carries no torque: the curve ramps to the pressure given, margin None."""
+    curve = extend_to_clamp(default_scene(), [0.0, 0.1], [0.0, 4e5], 0.1, clamp_pressure=6e5, rate_limit=1e8)
+    assert curve.margin is None and curve.clamp_pressure_Pa == 6e5
+    assert curve.ramp_end_s == pytest.approx(0.1 + 2e5 / 1e8, rel=1e-12)
+    assert list(curve.pressures) == [0.0, 4e5, 6e5]

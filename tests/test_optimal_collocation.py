@@ -52,6 +52,21 @@ def test_bad_scheme_degree_and_mesh_are_model_errors():
         DirectCollocation(intervals=1)
     with pytest.raises(ModelError, match="control"):
         DirectCollocation(control="cubic")
+    with pytest.raises(ModelError, match="mesh"):
+        DirectCollocation(intervals=3, mesh=[0.5, 0.5])
+    with pytest.raises(ModelError, match="mesh"):
+        DirectCollocation(intervals=2, mesh=[1.0, 0.0])
+
+
+GRADED = [0.05, 0.1, 0.2, 0.3, 0.2, 0.1, 0.05]     # interval shares, finest at both ends
+
+
+def test_graded_mesh_times_and_steps():
+    tr = DirectCollocation(7, 3, "radau", "linear", mesh=np.array(GRADED) * 3.0)    # normalised
+    starts, points = tr.node_times(2.0)
+    assert np.allclose(np.diff(starts), 2.0 * np.array(GRADED), rtol=0, atol=1e-15)
+    assert starts[-1] == 2.0 and np.allclose(tr.steps(2.0), np.diff(starts))
+    assert np.allclose(points[:, -1], starts[1:])                # Radau: the last point ends the interval
 
 
 # -- problems with known answers ----------------------------------------------------------------
@@ -81,12 +96,24 @@ def _solve(problem, transcription, T_bounds, p=(1.0,)):
     return float(sol["f"]), tr.unpack(np.array(sol["x"]).ravel())
 
 
+@pytest.mark.parametrize("mesh", [None, GRADED], ids=["uniform", "graded"])
 @pytest.mark.parametrize("scheme", ["radau", "legendre"])
-def test_minimum_jerk_with_linear_control_is_exact(scheme):
-    """A cubic slip history is in the collocation space, its optimal v = y'' is linear: J exact."""
+def test_minimum_jerk_with_linear_control_is_exact(scheme, mesh):
+    """A cubic slip history is in the collocation space, its optimal v = y'' is linear: J exact (on
+    any mesh, with its rate limit and quadrature on the graded steps)."""
     T = 1.3
-    J, _ = _solve(_double_integrator(path=True), DirectCollocation(8, 3, scheme, "linear"), (T, T))
+    n = 8 if mesh is None else len(mesh)
+    J, _ = _solve(_double_integrator(path=True), DirectCollocation(n, 3, scheme, "linear", mesh=mesh), (T, T))
     assert J == pytest.approx(jerk_lower_bound(1.0, 0.5, T), rel=1e-8)
+
+
+def test_free_final_time_on_a_graded_mesh():
+    rho = 2.0
+    J_of_T = lambda T: jerk_lower_bound(1.0, 0.5, T) + rho * T
+    ref = optimize.minimize_scalar(J_of_T, bounds=(0.2, 10.0), method="bounded", options={"xatol": 1e-12})
+    J, parts = _solve(_double_integrator(rho), DirectCollocation(7, 3, "radau", "linear", mesh=GRADED), (0.1, 10.0))
+    assert parts["T"] == pytest.approx(ref.x, rel=1e-6)
+    assert J == pytest.approx(ref.fun, rel=1e-9)
 
 
 def test_collocation_error_falls_as_intervals_grow():
@@ -134,14 +161,15 @@ def test_lq_slip_model_matches_python_control_lqr(scheme):
     assert parts["u"][0, 0] == pytest.approx(-(K @ x0)[0], rel=1e-3)
 
 
+@pytest.mark.parametrize("mesh", [None, [0.1, 0.2, 0.3, 0.4]], ids=["uniform", "graded"])
 @pytest.mark.parametrize("control_kind", ["constant", "linear"])
-def test_structured_derivatives_equal_casadi_ad(control_kind):
+def test_structured_derivatives_equal_casadi_ad(control_kind, mesh):
     """The assembled Jacobian and Hessian are CasADi's own, also with a rate limit and a path row."""
     problem = _double_integrator(rho=0.5, path=True)
     problem.u_rate, problem.u_initial = np.array([3.0]), np.array([0.2])
     xf, uf, T, p = ca.SX.sym("xf", 2), ca.SX.sym("uf"), ca.SX.sym("T"), ca.SX.sym("p", 1)
     problem.end = ca.Function("end", [xf, uf, T, p], [ca.vertcat(xf[0] * uf**2, xf[1] + T * uf)])
-    tr = DirectCollocation(4, 3, "radau", control_kind).transcribe(problem)
+    tr = DirectCollocation(4, 3, "radau", control_kind, mesh=mesh).transcribe(problem)
     reference = ca.nlpsol("reference", "ipopt", tr.nlp, {"print_time": False, "ipopt": {"print_level": 0, "sb": "yes"}})
     mine = structured_derivatives(tr)
     rng = np.random.default_rng(7)
@@ -172,3 +200,38 @@ def test_quadrature_of_the_objective_matches_scipy():
     assert jerk_lower_bound(1.0, 0.5, T) == pytest.approx(ref, rel=1e-12)
     starts = np.linspace(0.0, T, 9)
     assert np.allclose(parts["u"][:, 0], 2 * a + 6 * b * starts, atol=1e-7)
+
+
+# -- mesh grading ---------------------------------------------------------------------------------
+def test_graded_mesh_equidistributes_the_predicted_error():
+    """Local error C_k h^q with C 2^q times larger on the right half: the new mesh halves the right
+    half's steps, so that C h^q is equal everywhere (q = degree + 1)."""
+    from clutchocp.optimal.mesh import graded_mesh
+    degree, N = 3, 12
+    q = degree + 1
+    shares = np.full(N, 1.0 / N)
+    C = np.where(np.arange(N) < N // 2, 1.0, 2.0**q)
+    new = graded_mesh(shares, C * shares**q, degree)
+    assert new.sum() == pytest.approx(1.0, abs=1e-15)
+    assert np.allclose(new, np.r_[np.full(4, 0.125), np.full(8, 0.0625)], rtol=0, atol=1e-14)
+    C_new = np.where(np.cumsum(new) - new / 2 < 0.5, 1.0, 2.0**q)
+    assert np.allclose(C_new * new**q, (0.125**q), rtol=1e-12)
+
+
+def test_graded_mesh_guards_keep_it_regular():
+    """One interval with a huge defect: the new intervals crowd into it and grow away from it at most
+    by the density ratio 2 per old interval; none is longer than (1 + floor) / (N x floor)."""
+    from clutchocp.optimal.mesh import DENSITY_FLOOR, graded_mesh
+    N = 20
+    defects = np.full(N, 1e-12)
+    defects[0] = 1.0
+    new = graded_mesh(np.full(N, 1.0 / N), defects, 3)
+    nodes = np.r_[0.0, np.cumsum(new)]
+    assert np.sum(nodes < 1.0 / N) >= N // 3                     # a third of the nodes in the first interval
+    inside = new[:np.searchsorted(nodes, 1.0 / N) - 1]
+    assert np.allclose(inside, inside[0], rtol=1e-9)              # equal steps where the density is constant
+    # the density halves per old interval away from it: the second old interval holds half as many nodes
+    in_second = np.sum((nodes >= 1.0 / N) & (nodes < 2.0 / N))
+    assert in_second == pytest.approx(np.sum(nodes < 1.0 / N) / 2, abs=1)
+    assert new.max() <= (1 + DENSITY_FLOOR) / (N * DENSITY_FLOOR) * (1 + 1e-12)
+

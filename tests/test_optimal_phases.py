@@ -74,9 +74,12 @@ def test_fill_optimum_is_confirmed_by_idas(fill_ocp, fill_opt):
     assert idas["dissipated_energy_J"] == pytest.approx(colloc["dissipated_energy_J"], rel=2e-3)
 
 
-def test_phased_derivatives_equal_casadi_ad(fill_scene, fill_ocp):
+@pytest.mark.parametrize("meshes", [None, {"fill": [0.3, 0.7], "slip": [0.5, 0.2, 0.3]}], ids=["uniform", "graded"])
+def test_phased_derivatives_equal_casadi_ad(fill_scene, fill_ocp, meshes):
     small = EngagementOCP(fill_scene, intervals=3, fill_intervals=2, degree=2, baseline=fill_ocp.baseline,
-                          jerk_max=5e3)
+                          jerk_max=5e3, meshes=meshes)
+    if meshes is not None:
+        assert np.allclose(small.phased.parts[1].transcription.mesh, meshes["slip"])
     nlp = small.phased
     reference = ca.nlpsol("reference", "ipopt", nlp.nlp,
                           {"print_time": False, "ipopt": {"print_level": 0, "sb": "yes"}})
@@ -175,8 +178,7 @@ def test_fill_only_minimum_time_is_the_bang_bang_answer():
 
 
 # zhang2021 with the roughness split equally between the surfaces (stops in 2.44 s). With the scene's
-# own lining-rough pair the stop takes 4.97 s and its last approach is not resolved by a uniform mesh:
-# see the strict xfail below.
+# own lining-rough pair the stop takes 4.97 s; see test_brake_on_the_lining_rough_pair_verifies.
 BRAKE_EQUAL_SPLIT = {"actuation.max_pressure": "1.2 MPa", "roughness.sigma_1": 8.41e-6 / 2**0.5,
                      "roughness.sigma_2": 8.41e-6 / 2**0.5}
 
@@ -200,20 +202,31 @@ def test_brake_locks_as_the_input_comes_to_rest(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="zhang2021 as it stands (lining rough, separator smooth) stops in 4.97 s; "
-                   "on a uniform mesh the IDAS replay stops with a step of 13.2 % of the peak torque at 100 "
-                   "intervals and 7.9 % at 200 (lock time within 0.35 % and 0.28 %): the last approach to the stop "
-                   "needs a mesh graded towards t_f")
 def test_brake_on_the_lining_rough_pair_verifies():
+    """zhang2021 as it stands, at 1.2 MPa (twice its pressure limit: the stop takes 4.97 s, the fastest 3.6 s).
+    On 100 equal intervals (50 ms, the pressure rise at the start unresolved) IDAS stops 0.35 % late, after the
+    holding command has started, with a step of 13 % of the peak torque; one mesh graded from the interval
+    defects passes (measured: 0.001 % and 0.78 %)."""
+    from clutchocp.optimal.mesh import solve_verified
     scene = load_scene("zhang2021", {"actuation.max_pressure": "1.2 MPa"})
-    ocp = EngagementOCP(scene, intervals=100, degree=3)
-    opt = ocp.solve()
-    check, _ = verify(ocp.exact, opt)
-    assert check["passed"]
+    solved = solve_verified(EngagementOCP(scene, intervals=100, degree=3))
+    first, last = solved["history"][0], solved["history"][-1]
+    assert not first["graded"] and not first["passed"] and first["torque_jump_rel"] > 0.05
+    assert last["graded"] and last["passed"] and solved["check"]["passed"]
+    assert last["lock_time_rel_diff"] <= 1e-3 and last["torque_jump_rel"] <= 0.02
+    # the first interval of the graded mesh is several times finer than an equal one
+    assert last["smallest_interval_s"]["slip"] < 0.2 * last["engagement_time_s"] / 100
 
 
 def test_optimize_without_a_pressure_limit_says_to_set_it(capsys, tmp_path):
-    assert main(["optimize", "zhang2021", "--out", str(tmp_path / "a")]) == 2
+    """A scene without actuation.max_pressure (zhang2021 with that line removed) is refused in one line."""
+    from clutchocp.scene.loader import builtin_scene_dir
+    text = (builtin_scene_dir() / "zhang2021.toml").read_text(encoding="utf-8")
+    lines = [line for line in text.splitlines() if not line.startswith("max_pressure")]
+    assert len(lines) == len(text.splitlines()) - 1
+    path = tmp_path / "no_limit.toml"
+    path.write_text("\n".join(lines).replace('name = "zhang2021"', 'name = "no_limit"') + "\n", encoding="utf-8")
+    assert main(["optimize", str(path), "--out", str(tmp_path / "a")]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "actuation.max_pressure" in err and "--set actuation.max_pressure=" in err
     assert not (tmp_path / "a").exists()
@@ -260,3 +273,63 @@ def test_spring_applied_bao2020_optimum_is_confirmed_by_idas():
     assert abs(check["torque_jump_Nm"]) <= 0.02 * check["idas"]["peak_torque_Nm"]
     assert check["holding_pressure_Pa"] == 0.0                  # after lock-up the spring clamps
     assert check["idas"]["kiss_speed_m_s"] == pytest.approx(opt.terms["kiss_speed_m_s"], rel=1e-4)
+
+
+ENGAGEMENT_SCENES = ("bao2020", "bao2020_as_published", "default_driveline", "default_driveline_thermal",
+                     "default_fill", "zhang2021")
+
+
+def test_every_engagement_scene_is_listed_and_carries_a_pressure_limit():
+    from clutchocp.scene import list_scenes
+    assert sorted(s.name for s in list_scenes() if s.kind == "engagement") == sorted(ENGAGEMENT_SCENES)
+    for name in ENGAGEMENT_SCENES:
+        assert load_scene(name).get("actuation.max_pressure") is not None, name
+    assert load_scene("zhang2021").value("actuation.max_pressure") == 6e5          # Zhang Table 1, P_o
+
+
+@pytest.mark.parametrize("name", ["bao2020", "bao2020_as_published"])
+def test_bao_starts_held_released_by_the_pressure_that_balances_the_preload(name):
+    """initial_pressure x area = spring rate x preload (Bao Eq. 21 at x0 = 0 is zero): the piston
+    starts at rest; the limit leaves a margin above it."""
+    scene = load_scene(name)
+    k = scene.value("piston.spring_stiffness") * scene.value("piston.spring_count")
+    balance = k * scene.value("piston.spring_preload") / scene.value("piston.area")
+    assert scene.value("actuation.initial_pressure") == pytest.approx(balance, rel=1e-4)
+    assert scene.value("actuation.max_pressure") >= 1.2 * balance
+    from clutchocp.engagement.model import EngagementModel
+    model = EngagementModel(scene)
+    assert float(model.drive_force(scene.value("actuation.initial_pressure"), 0.0)) == pytest.approx(0.0, abs=10.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(
+    strict=True, reason="the fill optimum runs the piston through the pack and ends the fill on its way back "
+    "(kiss -7.8 m/s at 5.6 ms against IDAS 1.7 m/s at 0.85 ms): IDAS locks 4.7 % late (see README)"))
+    if n == "bao2020_as_published" else n for n in ENGAGEMENT_SCENES])
+def test_optimize_succeeds_on_every_engagement_scene(name, tmp_path):
+    """The done-when of the phased optimiser: no --set, the IDAS replay within its tolerances, no NaN."""
+    import json
+    assert main(["optimize", name, "--out", str(tmp_path / name)]) == 0
+    text = (tmp_path / name / "summary.json").read_text(encoding="utf-8")
+    assert "NaN" not in text and "Infinity" not in text
+    summary = json.loads(text)
+    assert summary["verification"]["passed"]
+    assert summary["verification"]["lock_time_rel_diff"] <= 0.01
+    assert summary["verification"]["torque_jump_rel"] <= 0.02
+
+
+def test_interval_defects_fall_with_the_order_the_grading_assumes():
+    """Halving the mesh of the default scene's optimum divides the median interval defect by about
+    2^q with q = degree + 1 = 4 (measured 19), between the stage order + 1 and the nonstiff local
+    order 2d = 6 of Radau IIA: the defect is a local error of the collocation, measured by CVODES."""
+    from clutchocp.optimal.mesh import ORDER_OVER_DEGREE, interval_defects
+    scene = default_scene()
+    baseline = simulate_engagement(scene)
+    t_max = baseline.summary["engagement_time_s"]
+    medians = []
+    for n in (20, 40):
+        ocp = EngagementOCP(scene, intervals=n, baseline=baseline)
+        opt = ocp.solve(t_max=t_max)
+        medians.append(np.median(interval_defects(ocp.exact, opt)[0]))
+    q = 3 + ORDER_OVER_DEGREE
+    assert 2 ** (q - 0.5) < medians[0] / medians[1] < 2 ** 6

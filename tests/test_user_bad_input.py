@@ -205,7 +205,7 @@ FLAG_CASES = [
     (["cycles", "default_driveline_thermal", "--cycles", "0"], ["--cycles", "from 1"]),
     (["cycles", "default_driveline_thermal", "--cooling-time", "-1"], ["--cooling-time", ">= 0"]),
     (["cycles", "default_driveline_thermal", "--max-temperature", "inf"], ["--max-temperature"]),
-    (["optimize", "bao2020"], ["actuation.max_pressure"]),
+    (["optimize", "zhang2021", "--set", "actuation.max_pressure=-1"], ["actuation.max_pressure", "(0, 1e8]"]),
     (["control", "zhang2021"], ["hvd"]),
     (["control", "liao2021_hvd", "--controller", "no_such_controller"], ["no_such_controller", "lqi, pi"]),
     (["scenes", "no_such_scene"], ["no_such_scene"]),

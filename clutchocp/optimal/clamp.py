@@ -50,13 +50,14 @@ class ClampedCommand:
 
     ``times`` [s] and ``pressures`` [Pa] are piecewise linear between the points and the last value
     holds afterwards; the ramp to ``clamp_pressure_Pa`` runs from ``ramp_start_s`` (lock-up) to
-    ``ramp_end_s`` at ``rate_limit_Pa_s``; ``margin`` = settled static capacity / ``locked_torque_Nm``.
+    ``ramp_end_s`` at ``rate_limit_Pa_s``; ``margin`` = settled static capacity / ``locked_torque_Nm``
+    (None for a clamp pressure given rather than sized: a lock that carries no torque).
     """
 
     times: np.ndarray
     pressures: np.ndarray
     clamp_pressure_Pa: float
-    margin: float
+    margin: float | None
     locked_torque_Nm: float
     ramp_start_s: float
     ramp_end_s: float
@@ -72,15 +73,14 @@ class ClampModel:
     Parameters
     ----------
     scene : clutchocp.scene.Scene
-        An engagement scene with a massless pack (``pack.model = "massless"``).
+        An engagement scene with a massless pack (``pack.model = "massless"``). With a piston the
+        settled pack also has the piston at rest on it (v0 = 0, its acceleration zero: pressure force
+        minus return spring equals the face force).
     """
 
     def __init__(self, scene):
         if scene.variant("pack") != "massless":
             raise ModelError("clamp pressure: computed for a massless pack (pack.model = 'massless')")
-        if scene.has("piston"):
-            raise ModelError("clamp pressure: computed for a pack pressed directly by the command pressure "
-                             "(no [piston] part)")
         u = ca.SX.sym("command")
         self.model = model = EngagementModel(scene, smooth=False, pressure_command=u)
         mode = model.modes[LOCKED_MODE]
@@ -89,6 +89,14 @@ class ClampModel:
         if model.actuation.has_state:            # settled valve: its pressure is the command
             x = ca.substitute(x, model.state("p_valve"), u)
         rates = ca.vertcat(*[mode.ode[i] for i in self.films])
+        if model.has_piston:
+            # the piston at rest: with v0 = 0 the film rates of equal films vanish for any thickness,
+            # and its acceleration (pressure force - return spring - face force) / m is what settles;
+            # scaled to a force fraction of the largest pressure force
+            i_v0 = model.index["v0"]
+            force = scene.value("piston.mass") / (scene.value("piston.area") * scene.get("actuation.max_pressure", 1e6))
+            rates = ca.vertcat(mode.ode[i_v0] * force * (model.H0 / 0.01), rates)
+        self.piston = model.has_piston
         outputs = [mode.outputs["static_capacity_Nm"], mode.outputs["pressure_Pa"]]
         self._fn = ca.Function("clamp", [model.x, u], [ca.substitute(ca.vertcat(rates, *outputs), model.x, x)])
         self._locked = ca.Function("locked", [model.x], [model.locked_torque()])
@@ -98,6 +106,8 @@ class ClampModel:
             if name in model.index:
                 self.x_lock[model.index[name]] = w_lock
         self.p_max = scene.get("actuation.max_pressure")
+        if model.has_piston:
+            self.x_lock[model.index["v0"]] = 0.0
 
     def locked_torque(self, state=None):
         """Torque the locked driveline carries [N m] (at ``state``, default: both sides at the output speed)."""
@@ -108,10 +118,12 @@ class ClampModel:
         model = self.model
         H0 = model.H0
 
+        n_rates = len(self.films) + self.piston
+
         def residual(h):
             x = self.x_lock.copy()
             x[self.films] = h
-            return np.array(self._fn(x, pressure)).ravel()[:len(self.films)] / (H0 / 0.01)
+            return np.array(self._fn(x, pressure)).ravel()[:n_rates] / (H0 / 0.01)
 
         # All films carry the same face force: solve one film first (bisection on a bracket),
         # then all of them together from there.
@@ -131,7 +143,7 @@ class ClampModel:
         """Static capacity [N m] of the settled pack under the command ``pressure`` [Pa]."""
         x = self.x_lock.copy()
         x[self.films] = self.settled_films(pressure)
-        return float(np.array(self._fn(x, pressure)).ravel()[len(self.films)])
+        return float(np.array(self._fn(x, pressure)).ravel()[len(self.films) + self.piston])
 
     def clamp_pressure(self, margin=DEFAULT_MARGIN, locked_torque=None):
         """Command pressure [Pa] whose settled capacity is ``margin`` x the locked torque.
@@ -152,11 +164,18 @@ class ClampModel:
             raise ModelError(f"clamp margin {margin:g}: the pressure limit {p_hi / 1e6:.4g} MPa gives a capacity of "
                              f"{top:.4g} N m, {top / demand:.3g} x the locked torque {demand:.4g} N m; "
                              "lower the margin or raise actuation.max_pressure")
-        return optimize.brentq(lambda p: self.capacity(p) - target, 1e-6 * p_hi, p_hi, xtol=1e-6, rtol=1e-12)
+        p_lo = 1e-6 * p_hi
+        scene = self.model.scene
+        if self.piston and scene.variant("piston") != "spring_applied":
+            # below the kiss pressure (return spring at the pack) the piston does not press the pack
+            k = scene.value("piston.spring_stiffness") * scene.value("piston.spring_count")
+            kiss = k * (scene.value("piston.spring_preload") + self.model.travel) / scene.value("piston.area")
+            p_lo = max(p_lo, 1.01 * kiss)
+        return optimize.brentq(lambda p: self.capacity(p) - target, p_lo, p_hi, xtol=1e-6, rtol=1e-12)
 
 
 def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MARGIN, rate_limit=None,
-                    locked_torque=None):
+                    locked_torque=None, clamp_pressure=None):
     """The engagement command up to lock-up continued by a ramp to the clamp pressure.
 
     Parameters
@@ -172,6 +191,10 @@ def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MAR
         Ramp rate [Pa/s] (default: actuation.max_pressure per 10 ms, the optimisation's default).
     locked_torque : float, optional
         Torque the locked driveline carries [N m] (default: from the model, both sides at the output speed).
+    clamp_pressure : float, optional
+        The pressure to ramp to [Pa], given instead of sized by ``margin``: for a lock that carries no
+        torque (a brake with its output held, a prescribed input speed without load), which no
+        capacity margin can size; the ClampedCommand's margin is then None.
 
     Returns
     -------
@@ -185,9 +208,16 @@ def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MAR
         raise ModelError("command: increasing times with one value each are needed")
     if not (np.isfinite(t_lock) and times[0] < t_lock):
         raise ModelError(f"t_lock = {t_lock!r}: must be a time after the command starts [s]")
-    clamp = ClampModel(scene)
-    p_c = clamp.clamp_pressure(margin, locked_torque)
-    rate = clamp.p_max / 0.01 if rate_limit is None else float(rate_limit)
+    if clamp_pressure is None:
+        clamp = ClampModel(scene)
+        p_c, p_max = clamp.clamp_pressure(margin, locked_torque), clamp.p_max
+        demand = abs(clamp.locked_torque() if locked_torque is None else float(locked_torque))
+    else:           # nothing to size: no clamp model (any pack)
+        p_c, p_max = float(clamp_pressure), scene.get("actuation.max_pressure")
+        demand = abs(float(locked_torque or 0.0))
+    if rate_limit is None and p_max is None:
+        raise ModelError("actuation.max_pressure: the clamp ramp's default rate (the limit per 10 ms) needs it")
+    rate = p_max / 0.01 if rate_limit is None else float(rate_limit)
     if not (np.isfinite(rate) and rate > 0):
         raise ModelError(f"rate_limit = {rate_limit!r}: must be a positive rate [Pa/s]")
     keep = times < t_lock
@@ -195,5 +225,5 @@ def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MAR
     t_end = t_lock + abs(p_c - p_lock) / rate
     out_t = np.concatenate([times[keep], [t_lock], [t_end] if t_end > t_lock else []])
     out_p = np.concatenate([values[keep], [p_lock], [p_c] if t_end > t_lock else []])
-    demand = abs(clamp.locked_torque() if locked_torque is None else float(locked_torque))
-    return ClampedCommand(out_t, out_p, p_c, margin, demand, float(t_lock), float(t_end), rate)
+    return ClampedCommand(out_t, out_p, p_c, margin if clamp_pressure is None else None, demand, float(t_lock),
+                          float(t_end), rate)

@@ -4,7 +4,7 @@ A problem on the normalised time s in [0, 1] with free final time T,
 
     dx/ds = T f(x, u, p),   integrals Q = int_0^1 T q(x, u, p) ds,   path bounds on c(x, u, p),
 
-is cut into ``intervals`` equal pieces; on each the state is the polynomial of degree ``degree``
+is cut into ``intervals`` pieces (equal by default, or of given shares of [0, 1]: a graded mesh); on each the state is the polynomial of degree ``degree``
 through the interval start (tau = 0) and the collocation points tau_1 .. tau_d, which satisfies the
 ODE at the collocation points (Radau IIA: tau_d = 1, stiffly accurate, order 2d - 1; Gauss-Legendre:
 interior points, order 2d). The integrals use the quadrature on the same points, which is what the
@@ -204,9 +204,12 @@ class DirectCollocation:
         Radau IIA (default) or Gauss-Legendre points.
     control : {"linear", "constant"}
         Continuous piecewise-linear or piecewise-constant control.
+    mesh : array (intervals,), optional
+        Share of each interval in [0, 1] (positive, summing to 1; normalised here); default: equal
+        intervals. Interval k has the step T mesh[k].
     """
 
-    def __init__(self, intervals=100, degree=3, scheme="radau", control="linear"):
+    def __init__(self, intervals=100, degree=3, scheme="radau", control="linear", mesh=None):
         if not (isinstance(intervals, (int, np.integer)) and intervals >= 2):
             raise ModelError(f"intervals {intervals!r}: an integer >= 2 is needed")
         if control not in CONTROLS:
@@ -216,10 +219,31 @@ class DirectCollocation:
         self.scheme = scheme
         self.control = control
         self.tau, self.C, self.D, self.B = collocation_coefficients(self.degree, scheme)
+        if mesh is None:
+            self.mesh = np.full(self.intervals, 1.0 / self.intervals)
+            self.uniform = True
+        else:
+            mesh = np.asarray(mesh, dtype=float).ravel()
+            if mesh.size != self.intervals or not np.all(np.isfinite(mesh)) or not np.all(mesh > 0):
+                raise ModelError(f"mesh: {self.intervals} positive interval shares are needed")
+            self.mesh = mesh / mesh.sum()
+            self.uniform = False
+        # step of each interval per unit T, relative to the equal step 1/N (1 on a uniform mesh)
+        self.stretch = np.ones(self.intervals) if self.uniform else self.mesh * self.intervals
 
     def __repr__(self):
+        graded = "" if self.uniform else f", graded mesh {self.mesh.min():.3g}..{self.mesh.max():.3g}"
         return (f"DirectCollocation(intervals={self.intervals}, degree={self.degree}, "
-                f"scheme={self.scheme!r}, control={self.control!r})")
+                f"scheme={self.scheme!r}, control={self.control!r}{graded})")
+
+    def with_mesh(self, mesh):
+        """The same transcription on another mesh (interval shares, see the class parameters)."""
+        return DirectCollocation(self.intervals if mesh is None else len(mesh), self.degree, self.scheme,
+                                 self.control, mesh)
+
+    def _stretch_row(self, repeat):
+        """Row DM of the interval stretches, each repeated ``repeat`` times (None on a uniform mesh)."""
+        return None if self.uniform else ca.DM(np.repeat(self.stretch, repeat)[None, :])
 
     @property
     def n_controls(self):
@@ -228,9 +252,18 @@ class DirectCollocation:
 
     def node_times(self, T):
         """Interval starts (N + 1,) and collocation times (N, d) for final time T."""
-        h = T / self.intervals
-        starts = np.arange(self.intervals + 1) * h
-        return starts, starts[:-1, None] + h * self.tau[None, :]
+        if self.uniform:
+            h = T / self.intervals
+            starts = np.arange(self.intervals + 1) * h
+            return starts, starts[:-1, None] + h * self.tau[None, :]
+        h = T * self.mesh
+        starts = np.concatenate([[0.0], np.cumsum(h)])
+        starts[-1] = T
+        return starts, starts[:-1, None] + h[:, None] * self.tau[None, :]
+
+    def steps(self, T):
+        """Step of each interval (N,) for final time T."""
+        return T * self.mesh
 
     def control_at_points(self, U):
         """Control at the collocation points from the control values (columns), as (n_u, N*d)."""
@@ -266,6 +299,8 @@ class DirectCollocation:
         Uc = self.control_at_points(U)
         xdot, q, c = problem.dynamics.map(N * d)(Xc, Uc, ca.repmat(P, 1, N * d))
         h = _repeat_columns(Tk, d) / N                               # step of each point's interval
+        if not self.uniform:
+            h = h * self._stretch_row(d)
         # Collocation equations: sum_r C[r, j] x_r = h xdot_j with x_0 the interval start.
         starts = _repeat_columns(X[:, :-1], d)
         C0 = np.tile(self.C[0], N)[None, :]                         # weight of the interval start
@@ -292,10 +327,12 @@ class DirectCollocation:
         if problem.u_rate is not None:
             if problem.u_initial is not None and self.control == "constant":
                 moves = U - ca.horzcat(ca.DM(problem.u_initial), U[:, :-1])
-                steps = Tk / N
+                steps = Tk / N if self.uniform else Tk / N * self._stretch_row(1)
             else:
                 moves = U[:, 1:] - U[:, :-1]
                 steps = Tk[:, :moves.size2()] / N
+                if not self.uniform:
+                    steps = steps * self._stretch_row(1)[:, :moves.size2()]
             limit = ca.mtimes(ca.DM(problem.u_rate), steps)          # (n_u, moves)
             rate = ca.vertcat(ca.vec(moves - limit), ca.vec(-moves - limit))
             blocks.append(("rate", rate, rate, -np.inf, 0.0))

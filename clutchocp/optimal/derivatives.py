@@ -115,6 +115,10 @@ def structured_derivatives(tr):
     Uc = col.control_at_points(U)
     Tk = w[tr.t_slice].T
     Tp = Tk[:, np.repeat(np.arange(N), d).tolist()]
+    if not col.uniform:
+        # a graded mesh: each point sees T_eff = stretch_k T (its step T_eff / N); the T column of
+        # its local derivatives is scaled by stretch_k where it is placed (_IndexMaps)
+        Tp = Tp * ca.DM(np.repeat(col.stretch, d)[None, :])
     Pp = ca.repmat(P, 1, n_pts)
     x_f = w[maps.x_start + n_x * N:maps.x_start + n_x * (N + 1)]
     u_f = U[:, -1]
@@ -194,6 +198,7 @@ class _IndexMaps:
         self.linear = col.control == "linear"
         self.n_controls = col.n_controls
         self.tau = col.tau
+        self.stretch = col.stretch
 
     def variable_images(self, pt, a):
         """Global indices and weights of local variable a (x, u, T) at point pt."""
@@ -206,7 +211,7 @@ class _IndexMaps:
                 return [(self.u_start + k * self.n_u + i, 1.0)]
             tau = self.tau[j]
             return [(self.u_start + k * self.n_u + i, 1.0 - tau), (self.u_start + (k + 1) * self.n_u + i, tau)]
-        return [(self.t_start + k, 1.0)]
+        return [(self.t_start + k, float(self.stretch[k]))]
 
     def end_images(self, a):
         """Global index of local end variable a (x_f, u_f, T)."""

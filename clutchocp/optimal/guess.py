@@ -78,36 +78,43 @@ def guess_from_run(ocp, run, t_max=None):
     ndarray
         The scaled NLP vector.
     """
+    pieces = []
+    for k, part in enumerate(ocp.phased.parts):
+        x, xc, u, T = phase_guess(ocp, run, k, part.transcription, t_max)
+        pieces.append(part.pack(x, xc, u[:, None], T))
+    return np.concatenate(pieces)
+
+
+def phase_guess(ocp, run, k, tr, t_max=None):
+    """The guess of phase k of ``ocp`` from a run, on the mesh of transcription ``tr`` (see
+    :func:`guess_from_run`): scaled node states (N + 1, n_x), collocation states (N, d, n_x), command
+    values (n_controls,) and duration."""
     windows = phase_windows(run)
     t_lock = run.summary["engagement_time_s"]
     squeeze = min(1.0, t_max / t_lock) if t_max is not None else 1.0
     res = run.result
     energy_all = sum(res[name] for name in DISSIPATED if name in run.model.energy_terms)
-    pieces = []
-    for k, (name, mode) in enumerate(ocp.phase_modes):
-        if mode not in windows:
-            raise ModelError(f"scene '{ocp.scene.name}': the guess run never enters mode '{mode}' of the {name} phase")
-        t0, t1 = windows[mode]
-        t, idx = mode_samples(run, mode, t0, t1)
-        part = ocp.phased.parts[k]
-        tr = part.transcription
-        starts, points = tr.node_times(1.0)                 # normalised times s in [0, 1]
+    name, mode = ocp.phase_modes[k]
+    if mode not in windows:
+        raise ModelError(f"scene '{ocp.scene.name}': the guess run never enters mode '{mode}' of the {name} phase")
+    t0, t1 = windows[mode]
+    t, idx = mode_samples(run, mode, t0, t1)
+    starts, points = tr.node_times(1.0)                 # normalised times s in [0, 1]
 
-        def states_at(s, t=t, idx=idx, t0=t0, t1=t1):
-            tau = t0 + s * (t1 - t0)
-            cols = [np.interp(tau, t, res[nm][idx]) / nominal for nm, nominal in zip(ocp.state_names, ocp.nominal)]
-            cols.append(np.interp(tau, t, energy_all[idx]) / ocp.scales.energy_J)
-            return np.stack(cols, axis=-1)
+    def states_at(s):
+        tau = t0 + s * (t1 - t0)
+        cols = [np.interp(tau, t, res[nm][idx]) / nominal for nm, nominal in zip(ocp.state_names, ocp.nominal)]
+        cols.append(np.interp(tau, t, energy_all[idx]) / ocp.scales.energy_J)
+        return np.stack(cols, axis=-1)
 
-        x, xc = states_at(starts), states_at(points)
-        if k == 0:
-            x[0] = np.append(ocp.x0 / ocp.nominal, 0.0)
-        s_u = 0.5 * (starts[:-1] + starts[1:]) if tr.control == "constant" else starts
-        tau_u = t0 + s_u * (t1 - t0)
-        u = command_history(run, tau_u) if ocp.has_valve else np.interp(tau_u, t, res["pressure_Pa"][idx])
-        u = np.clip(u, 0.0, ocp.p_max) / ocp.scales.pressure_Pa
-        pieces.append(part.pack(x, xc, u[:, None], squeeze * (t1 - t0) / ocp.scales.time_s))
-    return np.concatenate(pieces)
+    x, xc = states_at(starts), states_at(points)
+    if k == 0:
+        x[0] = np.append(ocp.x0 / ocp.nominal, 0.0)
+    s_u = 0.5 * (starts[:-1] + starts[1:]) if tr.control == "constant" else starts
+    tau_u = t0 + s_u * (t1 - t0)
+    u = command_history(run, tau_u) if ocp.has_valve else np.interp(tau_u, t, res["pressure_Pa"][idx])
+    u = np.clip(u, 0.0, ocp.p_max) / ocp.scales.pressure_Pa
+    return x, xc, u, squeeze * (t1 - t0) / ocp.scales.time_s
 
 
 def guess_from_optimum(ocp, opt, t_max=None):

@@ -152,6 +152,7 @@ class OptimalEngagement:
     t_max: float | None = None
     e_max: float | None = None
     phases: list = field(default_factory=list)
+    meshes: list = field(default_factory=list, repr=False)
 
     @property
     def success(self):
@@ -203,6 +204,10 @@ class EngagementOCP:
         After a smooth solve, re-solve on the exact forms from the smooth optimum.
     transcription : object, optional
         Replaces ``DirectCollocation(intervals, degree, scheme, control)``.
+    meshes : dict, optional
+        Interval shares of a graded mesh by phase name (``{"slip": array, "fill": array}``, each of
+        its phase's number of intervals; see :class:`~clutchocp.optimal.collocation.DirectCollocation`);
+        default: equal intervals. :meth:`refined` grades them from an optimum's interval defects.
     baseline : clutchocp.engagement.run.EngagementResult, optional
         IDAS run of the scene's own profile (initial guess and scales; simulated if not given).
     max_temperature_C : float, optional
@@ -219,7 +224,7 @@ class EngagementOCP:
     def __init__(self, scene, *, intervals=100, degree=3, scheme="radau", control="linear", rate_limit=None,
                  h_min=None, jump="constraint", lock_margin=0.005, smooth=True, polish=True,
                  transcription=None, baseline=None, fill_intervals=30, jerk_max=None, quasi_static_plates=None,
-                 max_temperature_C=None, max_specific_power_W_mm2=None):
+                 max_temperature_C=None, max_specific_power_W_mm2=None, meshes=None):
         if jump not in JUMP_MODES:
             raise ModelError(f"jump '{jump}': allowed values are {', '.join(JUMP_MODES)}")
         if scene.kind != "engagement":
@@ -240,7 +245,7 @@ class EngagementOCP:
                         "rate_limit": rate_limit, "h_min": h_min, "jump": jump, "lock_margin": lock_margin,
                         "fill_intervals": fill_intervals, "jerk_max": jerk_max,
                         "quasi_static_plates": quasi_static_plates, "max_temperature_C": max_temperature_C,
-                        "max_specific_power_W_mm2": max_specific_power_W_mm2}
+                        "max_specific_power_W_mm2": max_specific_power_W_mm2, "meshes": meshes}
         self.jerk_max = jerk_max
         self.u = ca.SX.sym("pressure_command")
         self.lock_margin = float(lock_margin)
@@ -261,10 +266,12 @@ class EngagementOCP:
         if start_mode not in (SLIP_MODE, FILL_MODE):
             raise ModelError(f"scene '{scene.name}' starts in mode '{start_mode}'; the optimisation covers an "
                              f"engagement that starts slipping forward (driveline.input_speed > output_speed)")
-        self.transcription = transcription or DirectCollocation(intervals, degree, scheme, control)
+        meshes = dict(meshes or {})
         # Phases (name, mode): the fill phase first if the piston starts with free travel.
         self.phase_modes = ([("fill", FILL_MODE)] if start_mode == FILL_MODE else []) + [("slip", SLIP_MODE)]
-        self.fill_transcription = DirectCollocation(fill_intervals, degree, scheme, control) \
+        self.transcription = transcription or DirectCollocation(intervals, degree, scheme, control,
+                                                                mesh=meshes.get("slip"))
+        self.fill_transcription = DirectCollocation(fill_intervals, degree, scheme, control, mesh=meshes.get("fill")) \
             if start_mode == FILL_MODE else None
         # Output held (a brake): the braked side is the input; its jerk is the one felt.
         self.output_held = not self.model.output_inertia and self.model.input_inertia
@@ -575,6 +582,37 @@ class EngagementOCP:
                                         transcription=self.transcription, **self.options)
         return self._exact
 
+    def refined(self, opt):
+        """The same problem on meshes graded from the interval defects of an optimum of this problem.
+
+        Each phase keeps its number of intervals; its new interval shares equidistribute the defects
+        (:func:`clutchocp.optimal.mesh.graded_mesh`). The baseline run is shared.
+        """
+        from .mesh import graded_mesh, interval_defects
+        solved_on = self.exact if self.polish and opt.stats.get("model") == "exact" else self
+        defects = interval_defects(solved_on, opt)
+        return self.with_meshes({name: graded_mesh(part.transcription.mesh, e, part.transcription.degree)
+                                 for (name, _), part, e in zip(self.phase_modes, self.phased.parts, defects)})
+
+    def coarsened(self, fraction):
+        """The same problem with ``fraction`` of the slip intervals (equal intervals; the fill phase
+        keeps its mesh); the baseline is shared."""
+        tr = self.transcription
+        options = dict(self.options, meshes=None, intervals=max(2, int(round(fraction * tr.intervals))),
+                       degree=tr.degree, scheme=tr.scheme, control=tr.control)
+        twin = EngagementOCP(self.scene, smooth=self.smooth, polish=self.polish, baseline=self.baseline, **options)
+        twin._fastest = self._fastest
+        return twin
+
+    def with_meshes(self, meshes):
+        """The same problem on other meshes (``{phase name: interval shares}``); the baseline is shared."""
+        tr = self.transcription
+        options = dict(self.options, meshes=meshes, intervals=tr.intervals, degree=tr.degree, scheme=tr.scheme,
+                       control=tr.control)
+        twin = EngagementOCP(self.scene, smooth=self.smooth, polish=self.polish, baseline=self.baseline, **options)
+        twin._fastest = self._fastest
+        return twin
+
     def solve(self, *, t_max=None, e_max=None, weights=None, guess=None):
         """Solve for the optimal command (and polish it on the exact model, see the class notes).
 
@@ -633,7 +671,7 @@ class EngagementOCP:
         from .guess import guess_from_optimum, guess_from_run
         nlp, sc = self.phased, self.scales
         warm = isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size \
-            and guess.lam_g.size == nlp.lbg.size
+            and guess.lam_g.size == nlp.lbg.size and self._same_meshes(guess)
         if warm:
             w0, lam_x0, lam_g0 = guess.w.copy(), guess.lam_x, guess.lam_g
         else:
@@ -673,6 +711,14 @@ class EngagementOCP:
         """The NLP parameter vector of a solve: the objective weights (a subclass with scene values
         as parameters, :mod:`clutchocp.study.parametric_ocp`, appends them)."""
         return [weights[k] for k in OBJECTIVE_TERMS]
+
+    def _same_meshes(self, opt):
+        """True if an optimum was solved on this problem's meshes (its vector can be reused as is)."""
+        mine = [part.transcription.mesh for part in self.phased.parts]
+        if not opt.meshes:              # an optimum built elsewhere (robust problem): equal intervals
+            return all(part.transcription.uniform for part in self.phased.parts)
+        return len(opt.meshes) == len(mine) and all(a.shape == b.shape and np.allclose(a, b, rtol=1e-12, atol=0.0)
+                                                    for a, b in zip(opt.meshes, mine))
 
     def _failure_message(self, stats, t_max):
         status = stats["status"]
@@ -743,7 +789,8 @@ class EngagementOCP:
             terms["peak_interface_temperature_C"] = float(max(outputs["interface_temperature_C"].max(),
                                                               outputs_points["interface_temperature_C"].max()))
         return OptimalEngagement(T, t, t_points, command_times, command, tr.transcription.control, states, outputs,
-                                 outputs_points, terms, objective, stats, w, lam_x, lam_g, weights, phases=phases)
+                                 outputs_points, terms, objective, stats, w, lam_x, lam_g, weights, phases=phases,
+                                 meshes=[part.transcription.mesh for part in self.phased.parts])
 
     def _phase_result(self, part, fns, parts, t_offset):
         """Times, command, states and outputs of one phase (physical units, times from t_offset)."""
@@ -762,7 +809,7 @@ class EngagementOCP:
         xc = parts["xc"].reshape(-1, parts["xc"].shape[-1])
         uc = np.array(tr.control_at_points(ca.DM(parts["u"].T))).ravel()
         outputs_points = {k: v.reshape(points.shape) for k, v in self._evaluate(xc, uc, fns).items()}
-        quad = tr.B[None, :] * (T / tr.intervals)
+        quad = tr.B[None, :] * tr.steps(T)[:, None]
         integrals = {key: float(np.sum(quad * outputs_points[key] ** 2))
                      for key in ("output_jerk_rad_s3", "slip_jerk_rad_s3")}
         states = {member: x_nodes[:, i] for i, name in enumerate(self._names) for member in self.state_groups[name]}

@@ -15,8 +15,9 @@ from .bound import jerk_lower_bound
 from .heat import heat_check
 from .clamp import DEFAULT_MARGIN, check_margin, extend_to_clamp
 from .problem import EngagementOCP
+from .mesh import solve_verified
 from .replay import CommandModel, simulate_command
-from .verify import run_numbers, verify
+from .verify import holding_pressure, run_numbers, verify
 
 KEYS = ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral", "dissipated_energy_J", "peak_jerk_rad_s3",
         "peak_torque_Nm")
@@ -115,11 +116,12 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
     ocp = EngagementOCP(scene, intervals=intervals, degree=degree, max_temperature_C=max_temperature_C,
                         max_specific_power_W_mm2=max_specific_power_W_mm2)
     build_time = time.perf_counter() - start
-    opt = ocp.solve(t_max=t_max, weights=weights)
-    say(f"  IPOPT {opt.stats['status']}: {opt.stats['iterations']} iterations, {opt.stats['wall_time_s']:.2f} s")
-    verifier = ocp.exact if ocp.polish else ocp
-    command_model = CommandModel(scene, opt.control)
-    check, replay = verify(verifier, opt, model=command_model)
+    command_model = CommandModel(scene, ocp.transcription.control)
+    solved = solve_verified(ocp, t_max=t_max, weights=weights, command_model=command_model, say=say)
+    ocp, opt, check, replay = solved["ocp"], solved["optimum"], solved["check"], solved["replay"]
+    graded = sum(h["stage"] == "graded mesh" and "failed" not in h for h in solved["history"])
+    say(f"  IPOPT {opt.stats['status']}: {opt.stats['iterations']} iterations, {opt.stats['wall_time_s']:.2f} s"
+        + (f" (after {graded} mesh refinement(s))" if graded else ""))
     say(f"  IDAS re-simulation: lock-up {_fmt(check['idas']['engagement_time_s'], 's')}, "
         f"jump {_fmt(check['torque_jump_Nm'], 'N m')}")
     # the calibration shape "fill pulse, hold, ramp" is that of a pressure-applied piston
@@ -127,8 +129,7 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
         if len(opt.phases) > 1 and ocp.apply_pressure > 0 else None
     curve, whole = _clamp_curve(scene, ocp, opt, command_model, clamp_margin)
     say(f"  after lock-up: ramp to the clamp pressure {curve.clamp_pressure_Pa / 1e6:.4g} MPa by "
-        f"{curve.ramp_end_s:.4g} s (capacity {curve.margin:g} x the locked torque); lock held in the IDAS replay: "
-        f"{whole['lock_held']}")
+        f"{curve.ramp_end_s:.4g} s ({_clamp_basis(curve)}); lock held in the IDAS replay: {whole['lock_held']}")
     baselines = simulate_baselines(scene)
     w_rel0, rate0 = ocp.initial_slip()
     bound = jerk_lower_bound(w_rel0, rate0, opt.t_f)
@@ -156,6 +157,8 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
                    "lock_margin": ocp.lock_margin},
         "weights": opt.weights,
         "phases": [{k: ph[k] for k in ("name", "mode", "t_start_s", "t_end_s", "intervals")} for ph in opt.phases],
+        "mesh": {"refinements": sum(h["stage"] == "graded mesh" and "failed" not in h for h in solved["history"]),
+                 "solves": solved["history"]},
         "lockup_definition": _lockup_definition(ocp),
         "clamp": {k: v for k, v in whole.items() if k != "run"},
         "solver": {"status": opt.stats["status"], "iterations": opt.stats["iterations"],
@@ -243,7 +246,12 @@ def _clamp_curve(scene, ocp, opt, command_model, margin):
         The curve and the summary entry ``clamp`` (with the replay run under ``run``).
     """
     rate = ocp.rate_limit if np.isfinite(ocp.rate_limit) else None
-    curve = extend_to_clamp(scene, opt.command_times, opt.command, opt.t_f, margin=margin, rate_limit=rate)
+    # a lock that carries no torque (brake, unloaded prescribed input) has no capacity to size a clamp
+    # by: the command goes to the holding pressure of the verification (the larger of the last command
+    # and the scene's set pressure; the smaller for a spring-applied piston)
+    given = None if ocp.holds_torque else holding_pressure(ocp, opt)
+    curve = extend_to_clamp(scene, opt.command_times, opt.command, opt.t_f, margin=margin, rate_limit=rate,
+                            clamp_pressure=given)
     t_end = curve.ramp_end_s + CLAMP_SETTLE_S
     run = simulate_command(scene, curve.times, curve.pressures, t_end, model=command_model, control="linear",
                            points=601)
@@ -255,9 +263,17 @@ def _clamp_curve(scene, ocp, opt, command_model, margin):
              "ramp_end_s": curve.ramp_end_s, "rate_limit_Pa_s": curve.rate_limit_Pa_s,
              "replay_end_s": t_end, "lock_time_s": lock[0] if lock else None,
              "lock_held": bool(lock) and not unlock,
-             "capacity_margin_at_end": float(run.result["static_capacity_Nm"][-1] / torque) if lock else None,
+             "capacity_margin_at_end": float(run.result["static_capacity_Nm"][-1] / torque)
+             if lock and abs(torque) > 1e-9 else None,
              "run": run}
     return curve, entry
+
+
+def _clamp_basis(curve):
+    """How the clamp pressure was chosen (for progress lines and legends)."""
+    if curve.margin is None:
+        return "holding pressure: the lock carries no torque"
+    return f"capacity {curve.margin:g} x the locked torque"
 
 
 def _fmt(value, unit, fmt="{:.4g}"):
@@ -374,7 +390,7 @@ def pressure_figure(scene, opt, replay, baseline, summary, curve=None, clamp_run
         t_hold = max(curve.times[-1], max(run.result.t[-1] for _, run, _ in runs))
         ax.plot(np.append(curve.times[after], t_hold), np.append(curve.pressures[after], curve.pressures[-1]) / 1e6,
                 color="C2", lw=1.2, ls="--",
-                label=f"command after lock-up: ramp to clamp ({curve.margin:g} x locked torque)")
+                label=f"command after lock-up: ramp to clamp ({_clamp_basis(curve)})")
     for label, run, color in runs:
         t, p = run.result.t, run.result["pressure_Pa"]
         if run is replay and clamp_run is not None:       # the curve a user applies, not the check's hold

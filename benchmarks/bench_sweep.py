@@ -78,7 +78,7 @@ def timed_sweep(work, name, **kw):
 def zhang_grid(points):
     n_viscosity = 10 if points >= 20 else 2
     n_pressure = max(1, points // n_viscosity)
-    return [f"actuation.pressure=0.4 MPa:0.8 MPa:{n_pressure}", f"oil.viscosity=0.04:0.08:{n_viscosity}"]
+    return [f"actuation.pressure=0.3 MPa:0.6 MPa:{n_pressure}", f"oil.viscosity=0.04:0.08:{n_viscosity}"]
 
 
 def parallel(work, points, options=None):

@@ -9,7 +9,7 @@ distributed = pytest.importorskip("distributed")
 from clutchocp.study import run_sweep  # noqa: E402
 from clutchocp.study.folder import RESULTS  # noqa: E402
 
-GRID = ["actuation.pressure=0.4 MPa:0.8 MPa:2", "oil.viscosity=0.04:0.06:2"]
+GRID = ["actuation.pressure=0.3 MPa:0.6 MPa:2", "oil.viscosity=0.04:0.06:2"]
 
 
 def _rows(folder):

@@ -8,7 +8,7 @@ from clutchocp.study import run_sweep
 from clutchocp.study.executor import batches, start_method
 from clutchocp.study.folder import RESULTS
 
-GRID = ["actuation.pressure=0.4 MPa:0.8 MPa:2", "oil.viscosity=0.04:0.06:3"]
+GRID = ["actuation.pressure=0.3 MPa:0.6 MPa:2", "oil.viscosity=0.04:0.06:3"]
 TIMING = ("build_time_s", "integration_time_s", "run_time_s")               # wall-clock, not results
 
 

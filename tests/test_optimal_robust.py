@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from clutchocp.errors import ModelError
-from clutchocp.optimal.problem import OBJECTIVE_TERMS, SLIP_MODE, EngagementOCP
+from clutchocp.optimal.problem import OBJECTIVE_TERMS, SLIP_MODE, EngagementOCP, check_weights
 from clutchocp.optimal.robust import ParametricOCP, RobustOCP, solve_robust
 from clutchocp.scene import default_scene
 
@@ -57,6 +57,33 @@ def test_one_scenario_is_the_nominal_problem(scene, nominal):
     terms = res.scenarios[0].terms
     assert terms["jerk_integral"] == pytest.approx(opt.terms["jerk_integral"], rel=1e-5)
     assert terms["lockup_torque_jump_Nm"] == pytest.approx(opt.terms["lockup_torque_jump_Nm"], rel=1e-5)
+
+
+def test_a_margin_on_t_max_is_the_nominal_problem_at_the_shorter_limit(scene, nominal):
+    """One scenario with t_max_margin m: the nominal optimum with t_max (1 - m), solved separately."""
+    ocp, opt = nominal
+    margin = 0.1
+    res = solve_robust(scene, [{}], intervals=N, t_max=opt.t_max, t_max_margin=margin)
+    short = EngagementOCP(scene, intervals=N, baseline=ocp.baseline).solve(t_max=(1 - margin) * opt.t_max)
+    assert res.t_max == pytest.approx((1 - margin) * opt.t_max, rel=1e-12)
+    assert res.t_limit == pytest.approx(opt.t_max, rel=1e-12)
+    assert res.lock_times[0] == pytest.approx(short.t_f, rel=1e-6)
+    assert res.objective == pytest.approx(short.objective, rel=1e-6)
+    assert res.objective > opt.objective                  # less time: more jerk
+
+
+def test_the_nominal_start_locks_every_scenario(scene, nominal):
+    """The start command (nominal optimum, then a ramp to the pressure limit) locks a scenario the
+    nominal optimum alone leaves slipping (mu -10 %), and the lock-up guesses stay within t_max."""
+    ocp, opt = nominal
+    mu = scene.value("friction.mu")
+    problem = RobustOCP(scene, [{"friction.mu": 0.9 * mu}, {"friction.mu": 1.1 * mu}], intervals=N,
+                        baseline=ocp.baseline)
+    problem._weights = check_weights(None)
+    runs = problem.start_runs(opt.t_max)
+    assert all(r.summary["engagement_time_s"] is not None for r in runs)
+    guess = problem._lock_guess(opt.t_max)
+    assert guess[1] < guess[0] <= opt.t_max
 
 
 @pytest.mark.slow
@@ -122,6 +149,8 @@ def test_bad_requests_are_model_errors(scene, nominal):
         problem.solve(scenario_weights=[1.0, 2.0])
     with pytest.raises(ModelError, match="fastest lock-up"):
         problem.solve(t_max=0.05)
+    with pytest.raises(ModelError, match="t_max_margin"):
+        problem.solve(t_max_margin=0.5)
     with pytest.raises(ModelError, match="control"):
         RobustOCP(scene, [{}], intervals=N, control="constant")
 

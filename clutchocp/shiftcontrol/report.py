@@ -39,6 +39,7 @@ COLOURS = {"baseline": "tab:gray", "nominal_optimum": "tab:blue", "robust_feedfo
 
 ROBUST_INTERVALS = 20        # command steps of the robust feedforward (9 scenarios: about 3 min)
 ROBUST_JUMP_WEIGHT = 30.0    # its jump penalty (the jump condition of optimize is infeasible over the box)
+ROBUST_T_MAX_MARGIN = 0.05   # its scenarios lock by 0.95 t_max, so that the clutches between them lock within t_max
 
 
 def robust_solver():
@@ -88,7 +89,7 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
             # one command rarely lets every scenario lock without a jump: the jump is a penalty (the
             # settings the robust solve converged with on the default scene, see the README)
             rob = solve_robust(scene, scenarios, t_max=t_max, intervals=ROBUST_INTERVALS, jump="penalty",
-                               weights={"jump": ROBUST_JUMP_WEIGHT})
+                               weights={"jump": ROBUST_JUMP_WEIGHT}, t_max_margin=ROBUST_T_MAX_MARGIN)
             failure = None if rob.success else f"IPOPT stopped with {rob.stats.get('status')}"
         except SolverError as exc:
             failure = str(exc)

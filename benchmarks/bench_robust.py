@@ -13,10 +13,18 @@ Acceptance (``--acceptance 9``): the robust command of a scenario set, the nomin
 own baseline profile, each replayed with IDAS at the 8 corners and the centre: lock-up time and
 torque jump at lock-up per corner; figures corner_jumps.png and commands.png in ``--out``.
 
+Monte Carlo (``--montecarlo SAMPLES``): the robust command of the 9 box points (continued by the
+clamp ramp, as ``clutchocp robust`` runs it) and the scene's own profile, open loop with IDAS, on the
+seeded draws of ``clutchocp robust`` in ``--workers`` processes: share of samples locked within t_max,
+|jump| as % of the locked torque (median, p95, worst), the robust worst over the baseline worst, and
+samples per second (both strategies per sample).
+
+Defaults are the settings of ``clutchocp robust`` (``ROBUST_*`` in clutchocp/shiftcontrol/report.py).
 Run from the repository root:
 
-    python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 30] [--jump-weight 100]
-        [--acceptance SCENARIOS] [--aggregate mean|worst] [--t-max-margin 0.005] [--out DIR] [--json FILE]
+    python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 10] [--jump-weight 100]
+        [--aggregate mean|worst] [--t-max-margin 0.05] [--montecarlo 200 --seed 0 --workers 2]
+        [--acceptance SCENARIOS] [--out DIR] [--json FILE]
 """
 
 import argparse
@@ -34,7 +42,7 @@ from clutchocp.optimal.robust import RobustOCP
 from clutchocp.optimal.replay import CommandModel, simulate_command
 from clutchocp.output import new_figure, save_figure
 from clutchocp.scene import default_scene
-from clutchocp.shiftcontrol.report import ROBUST_INTERVALS, ROBUST_JUMP_WEIGHT, ROBUST_T_MAX_MARGIN
+from clutchocp.shiftcontrol.report import ROBUST_AGGREGATE, ROBUST_INTERVALS, ROBUST_JUMP_WEIGHT, ROBUST_T_MAX_MARGIN
 
 def box_points(scene):
     """(corners, centre) of the scene's uncertainty box as override dicts [SI]."""
@@ -195,7 +203,7 @@ def main():
                         help="open-loop Monte Carlo of the 9-point robust command and the baseline (samples/s)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--aggregate", choices=("mean", "worst"), default="mean")
+    parser.add_argument("--aggregate", choices=("mean", "worst"), default=ROBUST_AGGREGATE)
     parser.add_argument("--out", default="out/bench_robust")
     parser.add_argument("--json", help="also write the results to this JSON file")
     args = parser.parse_args()

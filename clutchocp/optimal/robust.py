@@ -339,18 +339,22 @@ class RobustOCP:
             coarse = RobustOCP(self.scene, self.overrides, intervals=presolve_intervals,
                                **dict(self._ocp_options, polish=False, baseline=ocp.baseline))
             coarse._fastest, coarse._weights = fastest, weights
+            # The problem is not convex: the presolve runs from every start and keeps the lowest objective
+            # (two scenarios mu +-5 %, 12 steps, mean: 4.07 from the ramp start, 4.66 from the nominal one).
+            start = None
             for kind in STARTS:
                 coarse._start = kind
-                start = coarse._solve_model(coarse.ocp, t_max, weights, aggregate, omega, None, max_shifts, stages,
+                found = coarse._solve_model(coarse.ocp, t_max, weights, aggregate, omega, None, max_shifts, stages,
                                             f"smooth, {presolve_intervals} intervals, start {kind}")
-                if start.success:
-                    break
-            if not start.success:
-                start = None
-        for kind in STARTS:
-            self._start = kind
-            result = self._solve_model(ocp, t_max, weights, aggregate, omega, start, max_shifts, stages, "smooth")
-            if result.success or start is not None:
+                if found.success and (start is None or found.objective < start.objective):
+                    start = found
+        # From the presolve's solution if there is one, else (or if that fails) from each start in turn.
+        for kind, guess in ([(None, start)] if start is not None else []) + [(k, None) for k in STARTS]:
+            if kind is not None:
+                self._start = kind
+            result = self._solve_model(ocp, t_max, weights, aggregate, omega, guess, max_shifts, stages,
+                                       "smooth" if kind is None else f"smooth, start {kind}")
+            if result.success:
                 break
         if ocp.polish and result.success:
             polished = self._solve_model(ocp.exact, t_max, weights, aggregate, omega, result, max_shifts, stages,

@@ -297,8 +297,9 @@ class RobustOCP:
             Largest number of re-solves per stage that move a scenario's lock-up into the next command interval.
         presolve_intervals : int or None
             First solve the problem on this coarser command grid (smooth model only), where a
-            re-solve moves a lock-up by a longer step, and start from its lock-up times and states
-            (None, or not fewer than ``intervals``: start from the scenarios' baseline runs).
+            re-solve moves a lock-up by a longer step, from every start (``STARTS``), and start from
+            the lock-up times and states of the lowest objective (None, or not fewer than ``intervals``:
+            start from the scenarios' runs under the first start that converges).
 
         Returns
         -------

@@ -13,10 +13,18 @@ Acceptance (``--acceptance 9``): the robust command of a scenario set, the nomin
 own baseline profile, each replayed with IDAS at the 8 corners and the centre: lock-up time and
 torque jump at lock-up per corner; figures corner_jumps.png and commands.png in ``--out``.
 
+Monte Carlo (``--montecarlo SAMPLES``): the robust command of the 9 box points (continued by the
+clamp ramp, as ``clutchocp robust`` runs it) and the scene's own profile, open loop with IDAS, on the
+seeded draws of ``clutchocp robust`` in ``--workers`` processes: share of samples locked within t_max,
+|jump| as % of the locked torque (median, p95, worst), the robust worst over the baseline worst, and
+samples per second (both strategies per sample).
+
+Defaults are the settings of ``clutchocp robust`` (``ROBUST_*`` in clutchocp/shiftcontrol/report.py).
 Run from the repository root:
 
-    python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 30] [--jump-weight 100]
-        [--acceptance SCENARIOS] [--aggregate mean|worst] [--t-max-margin 0.005] [--out DIR] [--json FILE]
+    python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 10] [--jump-weight 100]
+        [--aggregate mean|worst] [--t-max-margin 0.05] [--montecarlo 200 --seed 0 --workers 2]
+        [--acceptance SCENARIOS] [--out DIR] [--json FILE]
 """
 
 import argparse
@@ -34,6 +42,7 @@ from clutchocp.optimal.robust import RobustOCP
 from clutchocp.optimal.replay import CommandModel, simulate_command
 from clutchocp.output import new_figure, save_figure
 from clutchocp.scene import default_scene
+from clutchocp.shiftcontrol.report import ROBUST_AGGREGATE, ROBUST_INTERVALS, ROBUST_JUMP_WEIGHT, ROBUST_T_MAX_MARGIN
 
 def box_points(scene):
     """(corners, centre) of the scene's uncertainty box as override dicts [SI]."""
@@ -58,8 +67,8 @@ def solve(scene, scenarios, intervals, jump_weight, t_max_margin=0.0, aggregate=
     problem.fastest_lockups()
     build = time.perf_counter() - start
     start = time.perf_counter()
-    result = problem.solve(weights={"jump": jump_weight}, t_max=(1 - t_max_margin) * problem.ocp.default_t_max(),
-                           aggregate=aggregate)
+    result = problem.solve(weights={"jump": jump_weight}, t_max=problem.ocp.default_t_max(),
+                           t_max_margin=t_max_margin, aggregate=aggregate)
     total = time.perf_counter() - start
     return problem, result, build, total
 
@@ -147,33 +156,92 @@ def plot(out, scene, rows, robust, nominal, problem, t_max, count):
     save_figure(fig, out / "commands.png")
 
 
+def montecarlo(scene, robust, samples, seed, workers):
+    """Open-loop Monte Carlo of the robust command (continued by its clamp ramp, as ``clutchocp robust``
+    runs it) beside the scene's own profile: the draws of ``clutchocp robust`` (seeded), IDAS, in
+    ``workers`` processes. Returns the per-strategy statistics and the samples per second."""
+    from clutchocp.shiftcontrol.closed_loop import post_lock_command
+    from clutchocp.shiftcontrol.design import pressure_limits
+    from clutchocp.shiftcontrol.montecarlo import Strategy, parallel_map, run_sample, strategy_statistics
+    from clutchocp.shiftcontrol.spec import load_slip_spec
+    from clutchocp.uncertainty import Uncertainty
+
+    spec = load_slip_spec()
+    uncertainty = Uncertainty.from_scene(scene)
+    nominal = scene.without_uncertainty()
+    p_lo, p_hi = pressure_limits(nominal, spec)
+    rate = (p_hi - p_lo) / spec.rate_limit_time                  # the ramp rate of clutchocp robust
+    p_set = nominal.value("actuation.pressure")
+    times, values = post_lock_command(nominal, robust.command_times, robust.command, float(robust.lock_times.max()),
+                                      rate)
+    strategies = [Strategy("baseline", "baseline", np.array([0.0, 1.0]), np.array([p_set, p_set])),
+                  Strategy("robust_feedforward", "robust feedforward + clamp", times, values)]
+    t_max = robust.t_limit
+    tasks = [{"scene_raw": nominal.raw, "scene_path": nominal.path, "overrides": d, "index": i, "strategies": strategies,
+              "t_max": t_max, "t_end": 1.5 * t_max + 0.05}
+             for i, d in enumerate(uncertainty.samples(samples, seed=seed))]
+    start = time.perf_counter()
+    rows = [row for sample in parallel_map(run_sample, tasks, workers=workers) for row in sample]
+    wall = time.perf_counter() - start
+    stats = strategy_statistics(rows)
+    return {"samples": samples, "seed": seed, "workers": workers, "t_max_s": t_max, "wall_s": wall,
+            "samples_per_s": samples / wall, "statistics": stats,
+            "worst_jump_over_baseline": stats["robust_feedforward"]["jump_pct"]["worst"]
+            / stats["baseline"]["jump_pct"]["worst"]}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenarios", type=int, nargs="*", default=[1, 3, 5, 9])
-    parser.add_argument("--intervals", type=int, default=30)
-    parser.add_argument("--jump-weight", type=float, default=100.0)
+    parser.add_argument("--intervals", type=int, default=ROBUST_INTERVALS)
+    parser.add_argument("--jump-weight", type=float, default=ROBUST_JUMP_WEIGHT)
     parser.add_argument("--acceptance", type=int, default=None, metavar="SCENARIOS",
                         help="solve with this scenario set (1, 3, 5, 9) and replay at the 9 box points")
-    parser.add_argument("--t-max-margin", type=float, default=0.0,
-                        help="solve the robust problem with t_max (1 - margin) (replays judged by t_max)")
-    parser.add_argument("--aggregate", choices=("mean", "worst"), default="mean")
+    parser.add_argument("--t-max-margin", type=float, default=ROBUST_T_MAX_MARGIN,
+                        help="every scenario locks by (1 - margin) t_max (replays judged by t_max)")
+    parser.add_argument("--montecarlo", type=int, default=0, metavar="SAMPLES",
+                        help="open-loop Monte Carlo of the 9-point robust command and the baseline (samples/s)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--aggregate", choices=("mean", "worst"), default=ROBUST_AGGREGATE)
     parser.add_argument("--out", default="out/bench_robust")
     parser.add_argument("--json", help="also write the results to this JSON file")
     args = parser.parse_args()
     scene = default_scene()
-    report = {"timing": []}
-    print(f"{'scenarios':>9s} {'build [s]':>10s} {'solve [s]':>10s} {'iterations':>10s} {'re-solves':>9s}")
+    report = {"timing": [], "settings": {"intervals": args.intervals, "jump_weight": args.jump_weight,
+                                         "t_max_margin": args.t_max_margin, "aggregate": args.aggregate}}
+    print(f"{'scenarios':>9s} {'build [s]':>10s} {'solve [s]':>10s} {'iterations':>10s} {'IPOPT runs':>10s} "
+          f"{'IPOPT [s/iteration]':>19s}")
+    solved = {}
     for count in args.scenarios:
         try:
-            _, result, build, total = solve(scene, scenario_set(scene, count), args.intervals, args.jump_weight)
+            _, result, build, total = solve(scene, scenario_set(scene, count), args.intervals, args.jump_weight,
+                                            args.t_max_margin, args.aggregate)
+            solved[count] = result
         except ClutchocpError as exc:
             report["timing"].append({"scenarios": count, "failed": str(exc)})
             print(f"{count:9d} failed: {exc}", flush=True)
             continue
         row = {"scenarios": count, "build_s": build, "solve_s": total, "iterations": result.stats["iterations"],
+               "ipopt_s": result.stats["wall_time_s"],
                "solves": len(result.stats["stages"]), "objective": result.objective}
         report["timing"].append(row)
-        print(f"{count:9d} {build:10.1f} {total:10.1f} {row['iterations']:10d} {row['solves']:9d}", flush=True)
+        print(f"{count:9d} {build:10.1f} {total:10.1f} {row['iterations']:10d} {row['solves']:10d} "
+              f"{row['ipopt_s'] / max(row['iterations'], 1):19.3f}", flush=True)
+    if args.montecarlo:
+        robust = solved.get(9)
+        if robust is None:
+            robust = solve(scene, scenario_set(scene, 9), args.intervals, args.jump_weight, args.t_max_margin,
+                           args.aggregate)[1]
+        mc = montecarlo(scene, robust, args.montecarlo, args.seed, args.workers)
+        report["montecarlo"] = mc
+        print(f"Monte Carlo, open loop: {mc['samples']} samples (seed {mc['seed']}), {mc['workers']} workers, "
+              f"{mc['wall_s']:.1f} s: {mc['samples_per_s']:.2f} samples/s (both strategies per sample)")
+        for name, st in mc["statistics"].items():
+            j = st["jump_pct"]
+            print(f"  {name:>20s}: lock within t_max = {mc['t_max_s']:.4f} s: {100 * st['lock_within_t_max_share']:.1f} %,"
+                  f" |jump| [% of locked torque] median {j['median']:.1f} / p95 {j['p95']:.1f} / worst {j['worst']:.1f}")
+        print(f"  robust worst |jump| / baseline worst |jump| = {mc['worst_jump_over_baseline']:.3f} (target <= 0.5)")
     if args.acceptance is not None:
         acc = acceptance(scene, args.intervals, args.jump_weight, Path(args.out), args.acceptance, args.t_max_margin,
                          args.aggregate)

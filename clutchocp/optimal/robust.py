@@ -24,7 +24,8 @@ interpolation to tie the copies together. The price of the aligned mesh is that 
 scenario locks in is discrete: after a solve, a scenario whose tau_s sits on a bound of its
 interval with a multiplier pushing beyond it moves to the next interval and the problem is solved
 again from the last solution (a coarse presolve on 10 command steps finds the intervals first, so
-the fine grid needs few such re-solves). With one scenario that locks at t_max (the jerk optimum
+the fine grid needs few such re-solves). The first lock-up intervals are those of each scenario's
+IDAS replay of the nominal optimum (:meth:`RobustOCP.start_runs`). With one scenario that locks at t_max (the jerk optimum
 uses all the time it may) the mesh is the nominal problem's and so is the optimum (checked in
 tests/test_optimal_robust.py).
 
@@ -65,7 +66,10 @@ from .replay import simulate_command
 
 AGGREGATES = ("mean", "worst")
 PRESOLVE_INTERVALS = 10
-STARTS = ("ramp", "baseline")      # start points tried in turn (see RobustOCP.start_runs)
+# IPOPT iterations per solve: on the 9-point default box every converged solve took at most 68; the
+# failing ones crawled on with a singular-looking step (regularisation ~1e7) to the default limit of 500
+MAX_ITERATIONS = 200
+STARTS = ("nominal", "ramp", "baseline")      # start points tried in turn (see RobustOCP.start_runs)
 
 
 class ParametricOCP(EngagementOCP):
@@ -159,6 +163,12 @@ class RobustEngagement:
     w: np.ndarray = field(repr=False)
     lam_x: np.ndarray = field(repr=False)
     lam_g: np.ndarray = field(repr=False)
+    t_max_margin: float = 0.0          # every scenario locks by (1 - t_max_margin) x the engagement-time limit
+
+    @property
+    def t_limit(self):
+        """The engagement-time limit the margin is taken from [s] (``t_max`` is the lock-up bound solved for)."""
+        return self.t_max / (1.0 - self.t_max_margin)
 
     @property
     def success(self):
@@ -256,7 +266,7 @@ class RobustOCP:
     def solver(self, nlp, warm):
         key = (id(nlp), warm)
         if key not in self._solvers:
-            options = dict(IPOPT_OPTIONS, **(WARM_OPTIONS if warm else {}))
+            options = dict(IPOPT_OPTIONS, max_iter=MAX_ITERATIONS, **(WARM_OPTIONS if warm else {}))
             self._solvers[key] = ca.nlpsol(f"robust_{'warm' if warm else 'cold'}", "ipopt", nlp.nlp,
                                            {"print_time": False, "ipopt": options, "error_on_fail": False,
                                             # stops IPOPT at the next iteration after a Ctrl-C
@@ -265,7 +275,7 @@ class RobustOCP:
 
     # -- solving ------------------------------------------------------------------------------
     def solve(self, *, t_max=None, weights=None, aggregate="mean", scenario_weights=None, max_shifts=40,
-              presolve_intervals=PRESOLVE_INTERVALS):
+              presolve_intervals=PRESOLVE_INTERVALS, t_max_margin=0.0):
         """Solve for the robust command (smooth stage, then the polish on the exact forms).
 
         Parameters
@@ -273,6 +283,10 @@ class RobustOCP:
         t_max : float, optional
             Latest lock-up of every scenario [s] (default: the nominal scene's, see
             :meth:`EngagementOCP.default_t_max`).
+        t_max_margin : float
+            Fraction of t_max kept free: every scenario must lock by (1 - t_max_margin) t_max, so that
+            clutches between the scenarios (and the replay of the command on the exact model) still lock
+            within t_max [-, in [0, 0.5)].
         weights : dict, optional
             Objective weights by term (``OBJECTIVE_TERMS``), the same for every scenario.
         aggregate : {"mean", "worst"}
@@ -283,8 +297,9 @@ class RobustOCP:
             Largest number of re-solves per stage that move a scenario's lock-up into the next command interval.
         presolve_intervals : int or None
             First solve the problem on this coarser command grid (smooth model only), where a
-            re-solve moves a lock-up by a longer step, and start from its lock-up times and states
-            (None, or not fewer than ``intervals``: start from the scenarios' baseline runs).
+            re-solve moves a lock-up by a longer step, from every start (``STARTS``), and start from
+            the lock-up times and states of the lowest objective (None, or not fewer than ``intervals``:
+            start from the scenarios' runs under the first start that converges).
 
         Returns
         -------
@@ -299,6 +314,7 @@ class RobustOCP:
         """
         ocp = self.ocp
         weights = check_weights(weights)
+        self._weights = weights
         if aggregate not in AGGREGATES:
             raise ModelError(f"aggregate '{aggregate}': allowed values are {', '.join(AGGREGATES)}")
         if ocp.jump_mode == "penalty" and weights["jump"] == 0:
@@ -310,6 +326,9 @@ class RobustOCP:
         t_max = ocp.default_t_max() if t_max is None else float(t_max)
         if not (np.isfinite(t_max) and t_max > 0):
             raise ModelError(f"t_max = {t_max!r}: must be a positive, finite time [s]")
+        if not (isinstance(t_max_margin, (int, float)) and 0.0 <= t_max_margin < 0.5):
+            raise ModelError(f"t_max_margin = {t_max_margin!r}: must be a fraction in [0, 0.5)")
+        t_max = (1.0 - t_max_margin) * t_max                   # the lock-up bound of every scenario
         fastest = self.fastest_lockups()
         if np.any(fastest > t_max):
             k = int(np.argmax(fastest))
@@ -320,28 +339,34 @@ class RobustOCP:
         if presolve_intervals is not None and presolve_intervals < self.intervals:
             coarse = RobustOCP(self.scene, self.overrides, intervals=presolve_intervals,
                                **dict(self._ocp_options, polish=False, baseline=ocp.baseline))
-            coarse._fastest = fastest
+            coarse._fastest, coarse._weights = fastest, weights
+            # The problem is not convex: the presolve runs from every start and keeps the lowest objective
+            # (two scenarios mu +-5 %, 12 steps, mean: 4.07 from the ramp start, 4.66 from the nominal one).
+            start = None
             for kind in STARTS:
                 coarse._start = kind
-                start = coarse._solve_model(coarse.ocp, t_max, weights, aggregate, omega, None, max_shifts, stages,
+                found = coarse._solve_model(coarse.ocp, t_max, weights, aggregate, omega, None, max_shifts, stages,
                                             f"smooth, {presolve_intervals} intervals, start {kind}")
-                if start.success:
-                    break
-            if not start.success:
-                start = None
-        for kind in STARTS:
-            self._start = kind
-            result = self._solve_model(ocp, t_max, weights, aggregate, omega, start, max_shifts, stages, "smooth")
-            if result.success or start is not None:
+                if found.success and (start is None or found.objective < start.objective):
+                    start = found
+        # From the presolve's solution if there is one, else (or if that fails) from each start in turn.
+        for kind, guess in ([(None, start)] if start is not None else []) + [(k, None) for k in STARTS]:
+            if kind is not None:
+                self._start = kind
+            result = self._solve_model(ocp, t_max, weights, aggregate, omega, guess, max_shifts, stages,
+                                       "smooth" if kind is None else f"smooth, start {kind}")
+            if result.success:
                 break
         if ocp.polish and result.success:
             polished = self._solve_model(ocp.exact, t_max, weights, aggregate, omega, result, max_shifts, stages,
                                          "exact")
             if polished.success:
                 result = polished
-        result.stats = dict(stages[-1], iterations=sum(s["iterations"] for s in stages),
-                            wall_time_s=sum(s["wall_time_s"] for s in stages), stages=stages,
-                            model=stages[-1]["model"] if result.success else stages[0]["model"])
+        # The status is the returned solution's own: a last re-solve that failed after it (a move of a
+        # lock-up the problem could not take) does not make a converged solution a failure.
+        result.stats = dict(result.stats, iterations=sum(s["iterations"] for s in stages),
+                            wall_time_s=sum(s["wall_time_s"] for s in stages), stages=stages)
+        result.t_max_margin = float(t_max_margin)
         if not result.success:
             raise SolverError(f"robust engagement: IPOPT stopped with {result.stats['status']} (scene "
                               f"'{self.scene.name}', {self.n_scenarios} scenarios, t_max = {t_max:.4g} s, "
@@ -365,7 +390,8 @@ class RobustOCP:
                 and tuple(guess.stats.get("lock_intervals", ())) == tuple(lock_intervals)
             result = self._solve_stage(ocp, nlp, t_max, weights, aggregate, omega, guess if warm else None,
                                        result or guess, warm)
-            stages.append(dict(result.stats, model=label))
+            result.stats["model"] = label
+            stages.append(dict(result.stats))
             if result.success:
                 converged = result
             elif converged is not None:
@@ -388,7 +414,11 @@ class RobustOCP:
     def start_runs(self, t_max):
         """IDAS runs of every scenario under the start command (cached per t_max and start).
 
-        Start "baseline": the scene's own pressure profile (its baseline; the command guess is the
+        Start "nominal" (tried first): the nominal scene's optimum on this grid (:meth:`nominal_optimum`),
+        then a ramp at the rate limit to the pressure limit, so that a scenario the optimum leaves
+        slipping locks too. Its lock-up guesses lie near the robust optimum's: on the 9-point default
+        box (10 command steps) the first solve converged in 19 iterations and two re-solves moved the
+        lock-ups into place, where the ramp start needed 22 re-solves, one interval at a time. Start "baseline": the scene's own pressure profile (its baseline; the command guess is the
         nominal baseline's). Start "ramp": a ramp over the first command step to the pressure limit,
         then held. The grid represents the ramp exactly, so the lock-up intervals it gives can be
         met; the baseline may leave a slow scenario unlocked by t_max, and then the intervals put a
@@ -401,7 +431,17 @@ class RobustOCP:
         key = (float(t_max), self._start)
         if getattr(self, "_start_key", None) != key:
             h_c = t_max / self.intervals
-            if self._start == "ramp":
+            opt = self.nominal_optimum(t_max) if self._start == "nominal" else None
+            if opt is not None:
+                # the nominal optimum, then a ramp at the rate limit to the pressure limit, so that the
+                # scenarios it leaves slipping (the weak corners) lock up too
+                rate = self.ocp.rate_limit if np.isfinite(self.ocp.rate_limit) else self.ocp.p_max / h_c
+                t_end, v_end = float(opt.command_times[-1]), float(opt.command[-1])
+                times = np.append(opt.command_times, t_end + max(self.ocp.p_max - v_end, 0.0) / rate + 1e-9)
+                values = np.append(opt.command, self.ocp.p_max)
+                self._start_runs = [simulate_command(s, times, values, 2.0 * t_max, control="linear")
+                                    for s in self.scenes]
+            elif self._start in ("nominal", "ramp"):    # (a nominal optimum that failed: the ramp)
                 times, values = [0.0, h_c], [self.ocp.scene.value("actuation.initial_pressure"), self.ocp.p_max]
                 self._start_runs = [simulate_command(s, times, values, 2.0 * t_max, control="linear")
                                     for s in self.scenes]
@@ -413,6 +453,20 @@ class RobustOCP:
             self._start_key = key
             self._start_command = (times, values)
         return self._start_runs
+
+    def nominal_optimum(self, t_max):
+        """The nominal scene's optimum on this command grid (smooth model, the weights of the solve;
+        cached per t_max), or None if IPOPT fails on it."""
+        key = (float(t_max), tuple(sorted(self._weights.items())))
+        if getattr(self, "_nominal_key", None) != key:
+            options = dict(self._ocp_options, polish=False, baseline=self.ocp.baseline)
+            try:
+                self._nominal = EngagementOCP(self.scene, intervals=self.intervals, **options).solve(
+                    t_max=t_max, weights=self._weights)
+            except SolverError:
+                self._nominal = None
+            self._nominal_key = key
+        return self._nominal
 
     def _lock_guess(self, t_max):
         """First guess of each scenario's lock-up [s]: under the start command (:meth:`start_runs`)."""
@@ -691,8 +745,17 @@ def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
     n_e = prob.end_lb.size
     end_lb, end_ub = prob.end_lb.copy(), prob.end_ub.copy()
     end_lb[-1], end_ub[-1] = -np.inf, np.inf                 # energy row: no e_max in the robust problem
+    # Path constraints at every point but one: with Radau points the last point of a scenario's mesh is
+    # its lock-up node, where the end condition w_rel = 0 holds, and the path row w_rel >= 0 there would
+    # be the same constraint twice (active, with equal gradients: no unique multipliers, and IPOPT met a
+    # singular step computation on the 9-point box).
+    n_c = prob.c_lb.size
+    keep = np.ones((n_pts, n_c), bool)
+    if np.isclose(tau[-1], 1.0):
+        keep[np.cumsum(n_ints * d) - 1, 0] = False
+    keep = np.flatnonzero(keep.ravel())                       # ca.vec(c) runs through the rows of each point
     blocks = [(ca.vertcat(*colloc), 0.0, 0.0), (ca.vertcat(*continuity), 0.0, 0.0),
-              (ca.vec(c), np.tile(prob.c_lb, n_pts), np.tile(prob.c_ub, n_pts)),
+              (ca.vec(c)[keep.tolist()], np.tile(prob.c_lb, n_pts)[keep], np.tile(prob.c_ub, n_pts)[keep]),
               (ca.vertcat(*g_end), np.tile(end_lb, n_s), np.tile(end_ub, n_s))]
     if prob.u_rate is not None:
         limit = float(prob.u_rate[0]) * h_c
@@ -726,7 +789,7 @@ def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
 
 
 def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean", intervals=60, degree=3,
-                 scenario_weights=None, presolve_intervals=PRESOLVE_INTERVALS, **ocp_options):
+                 scenario_weights=None, presolve_intervals=PRESOLVE_INTERVALS, t_max_margin=0.0, **ocp_options):
     """One pressure command for several scenarios of a clutch (see the module notes).
 
     Parameters
@@ -736,7 +799,10 @@ def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean"
     scenarios : list of dict
         Override dicts ``{"part.key": SI value}`` (e.g. ``Uncertainty.corners()``), one per scenario.
     t_max : float, optional
-        Latest lock-up of every scenario [s] (default: the nominal baseline's lock-up time).
+        Engagement-time limit [s] (default: the nominal baseline's lock-up time).
+    t_max_margin : float
+        Every scenario locks by (1 - t_max_margin) t_max [-, in [0, 0.5)], so that clutches between the
+        scenarios still lock within t_max (``RobustEngagement.t_max`` is that bound, ``.t_limit`` t_max).
     weights : dict, optional
         Objective weights by term (jerk, energy, time, jump, smooth).
     aggregate : {"mean", "worst"}
@@ -755,4 +821,4 @@ def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean"
     """
     problem = RobustOCP(scene, scenarios, intervals=intervals, degree=degree, **ocp_options)
     return problem.solve(t_max=t_max, weights=weights, aggregate=aggregate, scenario_weights=scenario_weights,
-                         presolve_intervals=presolve_intervals)
+                         presolve_intervals=presolve_intervals, t_max_margin=t_max_margin)

@@ -37,8 +37,14 @@ COLOURS = {"baseline": "tab:gray", "nominal_optimum": "tab:blue", "robust_feedfo
            "closed_loop": "tab:red"}
 
 
-ROBUST_INTERVALS = 20        # command steps of the robust feedforward (9 scenarios: about 3 min)
-ROBUST_JUMP_WEIGHT = 30.0    # its jump penalty (the jump condition of optimize is infeasible over the box)
+# The robust feedforward over the box points, with the settings it converges with on the default scene
+# (README, "Robust feedforward"): 10 command steps (20 stopped in IPOPT), the worst scenario's objective,
+# the jump as a penalty (the jump condition of optimize is infeasible over the box), and every scenario
+# locked by 0.95 t_max, so that the clutches between them lock within t_max.
+ROBUST_INTERVALS = 10
+ROBUST_JUMP_WEIGHT = 100.0
+ROBUST_AGGREGATE = "worst"
+ROBUST_T_MAX_MARGIN = 0.05
 
 
 def robust_solver():
@@ -82,13 +88,14 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         say("  robust feedforward: not available (clutchocp.optimal.robust is not installed); skipped")
     else:
         scenarios = uncertainty.corners() + [uncertainty.centre()]
-        say(f"  robust feedforward over {len(scenarios)} scenarios ({ROBUST_INTERVALS} intervals, jump as a "
-            f"penalty of weight {ROBUST_JUMP_WEIGHT:g})")
+        say(f"  robust feedforward over {len(scenarios)} scenarios ({ROBUST_INTERVALS} intervals, {ROBUST_AGGREGATE} "
+            f"scenario, jump as a penalty of weight {ROBUST_JUMP_WEIGHT:g}, lock-up by "
+            f"{1 - ROBUST_T_MAX_MARGIN:g} t_max)")
         try:
-            # one command rarely lets every scenario lock without a jump: the jump is a penalty (the
-            # settings the robust solve converged with on the default scene, see the README)
+            # one command rarely lets every scenario lock without a jump: the jump is a penalty
             rob = solve_robust(scene, scenarios, t_max=t_max, intervals=ROBUST_INTERVALS, jump="penalty",
-                               weights={"jump": ROBUST_JUMP_WEIGHT})
+                               weights={"jump": ROBUST_JUMP_WEIGHT}, aggregate=ROBUST_AGGREGATE,
+                               t_max_margin=ROBUST_T_MAX_MARGIN)
             failure = None if rob.success else f"IPOPT stopped with {rob.stats.get('status')}"
         except SolverError as exc:
             failure = str(exc)
@@ -102,7 +109,9 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         r_times, r_values = post_lock_command(scene, rob.command_times, rob.command, t_end_command, rate)
         strategies.append(Strategy("robust_feedforward", "robust feedforward + clamp", r_times, r_values))
         feedforward = ("robust_feedforward", np.asarray(rob.command_times), np.asarray(rob.command))
-        facts["robust_feedforward"] = {"scenarios": len(scenarios),
+        facts["robust_feedforward"] = {"scenarios": len(scenarios), "intervals": ROBUST_INTERVALS,
+                                       "aggregate": ROBUST_AGGREGATE, "jump_weight": ROBUST_JUMP_WEIGHT,
+                                       "t_max_margin": ROBUST_T_MAX_MARGIN,
                                        "lock_times_s": [float(s.t_f) for s in rob.scenarios],
                                        "stats": {k: v for k, v in rob.stats.items()
                                                  if isinstance(v, (bool, int, float, str))}}

@@ -17,6 +17,8 @@ def test_builtin_spec_loads_with_units():
     assert spec.lqi["slip_tolerance"] == pytest.approx(0.003)
     assert spec.t_max_fraction == 1.0
     assert parse_slip_spec({**GOOD, "feedforward": {"t_max_fraction": 0.85}}).t_max_fraction == pytest.approx(0.85)
+    assert spec.feedforward_curve == "nominal"
+    assert parse_slip_spec({**GOOD, "feedforward": {"curve": "robust"}}).feedforward_curve == "robust"
 
 
 @pytest.mark.parametrize("raw, match", [
@@ -33,6 +35,7 @@ def test_builtin_spec_loads_with_units():
     ({"controller": {**GOOD["controller"], "progress": "speed"}}, r"controller\.progress = 'speed': allowed values are slip, time"),
     ({**GOOD, "feedforward": {"t_max_fraction": 1.2}}, r"feedforward\.t_max_fraction = 1\.2: must be in \(0, 1\]"),
     ({**GOOD, "feedforward": {"t_max_fraction": 0}}, r"feedforward\.t_max_fraction = 0: must be > 0"),
+    ({**GOOD, "feedforward": {"curve": "best"}}, r"feedforward\.curve.*nominal, robust"),
     ({**GOOD, "feedforward": {"t_max_fracton": 0.9}}, r"feedforward\.t_max_fracton: unknown key .*did you mean 't_max_fraction'"),
 ])
 def test_bad_specs_raise_one_line(raw, match):

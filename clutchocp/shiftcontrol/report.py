@@ -108,15 +108,18 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         t_end_command = float(max(s.t_f for s in rob.scenarios))
         r_times, r_values = post_lock_command(scene, rob.command_times, rob.command, t_end_command, rate)
         strategies.append(Strategy("robust_feedforward", "robust feedforward + clamp", r_times, r_values))
-        feedforward = ("robust_feedforward", np.asarray(rob.command_times), np.asarray(rob.command))
+        if spec.feedforward_curve == "robust":
+            feedforward = ("robust_feedforward", np.asarray(rob.command_times), np.asarray(rob.command))
         facts["robust_feedforward"] = {"scenarios": len(scenarios), "intervals": ROBUST_INTERVALS,
                                        "aggregate": ROBUST_AGGREGATE, "jump_weight": ROBUST_JUMP_WEIGHT,
                                        "t_max_margin": ROBUST_T_MAX_MARGIN,
                                        "lock_times_s": [float(s.t_f) for s in rob.scenarios],
                                        "stats": {k: v for k, v in rob.stats.items()
                                                  if isinstance(v, (bool, int, float, str))}}
-    if rob is None and spec.t_max_fraction < 1.0:
-        # no robust feedforward: the loop tracks a nominal optimum that locks with a time margin, so that
+    if spec.feedforward_curve == "robust" and rob is None:
+        say("  feedforward.curve = 'robust' but no robust feedforward converged: the loop tracks the nominal optimum")
+    if feedforward[0] == "nominal_optimum" and spec.t_max_fraction < 1.0:
+        # the loop tracks a nominal optimum that locks with a time margin, so that
         # a slower clutch can still lock within t_max (feedforward.t_max_fraction of the spec)
         t_ff = spec.t_max_fraction * t_max
         say(f"  nominal optimum for the closed loop at {spec.t_max_fraction:g} x t_max = {t_ff:.4g} s")

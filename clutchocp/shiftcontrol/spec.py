@@ -23,8 +23,9 @@ field::
     [anti_windup]
     method = "clamping"              # or "none"
 
-    [feedforward]                    # without a robust feedforward: the nominal optimum the loop tracks
-    t_max_fraction = 1.0             # is solved with t_max x this, so it locks with a time margin
+    [feedforward]
+    curve = "nominal"                # the curve the loop tracks: "nominal" optimum or "robust" feedforward
+    t_max_fraction = 1.0             # the nominal optimum is solved with t_max x this (a time margin)
 """
 
 from dataclasses import dataclass, field
@@ -37,6 +38,7 @@ from ..scene.loader import _suggest
 TYPES = ("slip_lqi",)
 ANTI_WINDUP = ("clamping", "none")
 PROGRESS = ("slip", "time")
+CURVES = ("nominal", "robust")
 
 _CONTROLLER = {
     "name": ("str", None, ""),
@@ -58,7 +60,7 @@ _LQI = {
     "terminal_weight": ("1", "nonnegative", 10.0),
 }
 _ANTI_WINDUP = {"method": ("choice", ANTI_WINDUP, "clamping")}
-_FEEDFORWARD = {"t_max_fraction": ("1", "positive", 1.0)}
+_FEEDFORWARD = {"curve": ("choice", CURVES, "nominal"), "t_max_fraction": ("1", "positive", 1.0)}
 _TABLES = {"controller": _CONTROLLER, "lqi": _LQI, "anti_windup": _ANTI_WINDUP, "feedforward": _FEEDFORWARD}
 _REQUIRED = ("type", "sample_time")
 
@@ -78,6 +80,7 @@ class SlipControlSpec:
     max_delay: float = 0.05
     lqi: dict = field(default_factory=lambda: {k: v[2] for k, v in _LQI.items()})
     anti_windup: str = "clamping"
+    feedforward_curve: str = "nominal"
     t_max_fraction: float = 1.0
     path: Path | None = None
 
@@ -126,4 +129,5 @@ def parse_slip_spec(raw):
                            pressure_min=c["pressure_min"], pressure_max=c["pressure_max"],
                            rate_limit_time=c["rate_limit_time"], measure_pressure=c["measure_pressure"],
                            progress=c["progress"], max_delay=c["max_delay"],
-                           lqi=weights, anti_windup=values["anti_windup"]["method"], t_max_fraction=fraction)
+                           lqi=weights, anti_windup=values["anti_windup"]["method"],
+                           feedforward_curve=values["feedforward"]["curve"], t_max_fraction=fraction)

@@ -63,8 +63,8 @@ def test_robust_run_is_reproducible_with_its_seed(tmp_path):
 
 def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch):
     """Plumbing only: a stand-in for clutchocp.optimal.robust.solve_robust (contract: one shared command,
-    per-scenario lock times) returns the nominal optimum; the strategy list and the closed loop's
-    feedforward must pick it up."""
+    per-scenario lock times) returns the nominal optimum; the strategy list must pick it up, and the
+    closed loop's feedforward when the spec asks for the robust curve."""
     from types import SimpleNamespace
 
     from clutchocp.optimal.problem import EngagementOCP
@@ -81,9 +81,14 @@ def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch)
                                scenarios=[opt], stats={"status": "stand-in"})
 
     monkeypatch.setattr(report, "robust_solver", lambda: stand_in)
+    spec = load_slip_spec()
     strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene),
-                                                load_slip_spec(), intervals=30, say=lambda *a: None)
+                                                spec, intervals=30, say=lambda *a: None)
     assert [s.name for s in strategies] == ["baseline", "nominal_optimum", "robust_feedforward", "closed_loop"]
+    assert facts["closed_loop"]["feedforward"] == "nominal_optimum"          # feedforward.curve = "nominal"
+    spec.feedforward_curve = "robust"
+    strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene),
+                                                spec, intervals=30, say=lambda *a: None)
     assert facts["closed_loop"]["feedforward"] == "robust_feedforward"
     assert len(seen["scenarios"]) == 9                       # 2^3 corners and the centre
     assert facts["robust_feedforward"]["stats"] == {"status": "stand-in"}

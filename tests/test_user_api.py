@@ -252,3 +252,13 @@ def test_closed_loop_figure_shows_valve_limits_and_load_steps(monkeypatch, tmp_p
     figures["static_map.png"].canvas.draw()
     labels = [t.get_text() for t in axis.get_ticklabels() if t.get_text()]
     assert len(labels) >= 3, labels
+
+
+def test_a_pressure_release_has_no_zhang_response_times(bao):
+    """bao2020 engages by releasing the pressure that holds it open (set 0 Pa below the initial
+    63.66 MPa): Zhang's times, measured from a rise to the set pressure, do not apply, and its
+    figures draw no torque-response panel."""
+    scene = bao.model.scene
+    assert scene.value("actuation.pressure") < scene.value("actuation.initial_pressure")
+    assert bao.summary["torque_response_time_stable_s"] is None
+    assert bao.summary["torque_response_time_s"] is None

@@ -207,7 +207,7 @@ def _first_crossing(t, y, level, piece=None):
 
 def pressure_rise_time(model, result, fraction):
     """First time [s] the pressure has risen by ``fraction`` of the way to the set pressure (located on
-    the local cubic of the samples), or None."""
+    the local cubic of the samples), or None (also when the set pressure is not above the initial one)."""
     return pressure_rise_times(model, result, (fraction,))[fraction]
 
 
@@ -216,7 +216,7 @@ def pressure_rise_times(model, result, fractions, piece=None):
     the pressure samples read once; ``piece``: :func:`pieces` of ``result`` if already at hand."""
     p_set = model.scene.value("actuation.pressure")
     p0 = model.scene.value("actuation.initial_pressure")
-    if p_set == p0:
+    if p_set <= p0:       # no rise (a release: spring-applied clutch): Zhang's response times do not apply
         return dict.fromkeys(fractions)
     rise = (result["pressure_Pa"] - p0) / (p_set - p0)
     piece = pieces(result) if piece is None else piece

@@ -16,6 +16,9 @@ Numbers (written to ``bench_sweep.json`` and printed):
 * ``dask_over_local``: the same sweep on a Dask LocalCluster (2 worker processes, 1 thread each,
   started inside the timing) over the 2-worker local pool; target <= 1.2. The three sweeps run
   ``--rounds`` times (default 3), alternating, and the medians are compared (``runs_s``: each run).
+  ``cpu_sweep_process_s``, ``cpu_workers_s``: median CPU seconds of the sweep's own process (first
+  point, Dask scheduler, writing, figures) and of its worker processes (with the Dask nannies and
+  the process drawing half of the figures); they move much less with the load than wall times.
 * ``command_line``: the same three sweeps as whole commands, as a user runs them
   (``python -m clutchocp.cli sweep zhang2021 --grid ... --workers N``: interpreter start, imports,
   the sweep, figures and summary), alternating, medians: ``parallel_efficiency`` and
@@ -69,12 +72,25 @@ def rows_of(folder):
         return [{k: v if k in TEXT_COLUMNS else parse_cell(v) for k, v in r.items()} for r in csv.DictReader(fh)]
 
 
+def cpu_s():
+    """CPU seconds (user + system) of this process and of its finished child processes."""
+    import resource
+
+    return tuple(sum(getattr(resource.getrusage(who), a) for a in ("ru_utime", "ru_stime"))
+                 for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+
+
+CPU = {}        # name of a timed sweep -> (CPU of this process, CPU of its workers) [s]
+
+
 def timed_sweep(work, name, **kw):
     folder = Path(work) / name
     clear_caches()                       # this process's models from earlier sweeps: built again, timed
+    cpu = cpu_s()
     start = time.perf_counter()
     summary = run_sweep(out_dir=folder, progress=False, **kw)
     wall = time.perf_counter() - start
+    CPU[name] = tuple(b - a for a, b in zip(cpu, cpu_s()))
     if summary["points_ok"] != summary["points"]:
         raise RuntimeError(f"{name}: {summary['points_failed']} points failed: {summary['failures'][:2]}")
     return wall, summary, rows_of(folder)
@@ -94,17 +110,20 @@ def parallel(work, points, options=None, rounds=3):
     out["native_first_build_s"] = timed_sweep(work, "warmup", scene="zhang2021", grid=warm, engine="serial")[0]
     runs = {"local1": dict(engine="local", workers=1), "local2": dict(engine="local", workers=2),
             "dask2": dict(engine="dask", workers=2)}
-    wall, inner = {k: [] for k in runs}, {k: [] for k in runs}
+    wall, inner, cpu = {k: [] for k in runs}, {k: [] for k in runs}, {k: [] for k in runs}
     for r in range(rounds):                 # side by side, alternating: the load changes from minute to minute
         for name, kw in runs.items():
             t, s, _ = timed_sweep(work, f"{name}_{r}", scene="zhang2021", grid=grid, options=options, **kw)
             wall[name].append(t)
             inner[name].append(s["wall_time_s"])
+            cpu[name].append(CPU[f"{name}_{r}"])
             out["points"] = s["points"]
     t1, t2, td = (statistics.median(wall[k]) for k in runs)
     s1, s2, sd = (statistics.median(inner[k]) for k in runs)
     out.update(local_1_worker_s=t1, local_2_workers_s=t2, dask_2_workers_s=td,
                runs_s={k: [round(v, 3) for v in wall[k]] for k in runs},
+               cpu_sweep_process_s={k: statistics.median(c[0] for c in cpu[k]) for k in runs},
+               cpu_workers_s={k: statistics.median(c[1] for c in cpu[k]) for k in runs},
                parallel_efficiency=t1 / (2 * t2), dask_over_local=td / t2,
                parallel_efficiency_sweep_only=s1 / (2 * s2), dask_over_local_sweep_only=sd / s2,
                runs_per_second_per_core=out["points"] / t2 / 2, load_after=load())

@@ -14,7 +14,15 @@ Numbers (written to ``bench_sweep.json`` and printed):
   before each timed sweep): ``T1 / (2 T2)``; target >= 0.85. ``parallel_efficiency_sweep_only``:
   the same from the sweeps' own ``wall_time_s`` (without the figures drawn at the end).
 * ``dask_over_local``: the same sweep on a Dask LocalCluster (2 worker processes, 1 thread each,
-  started inside the timing) over the 2-worker local pool; target <= 1.2.
+  started inside the timing) over the 2-worker local pool; target <= 1.2. The three sweeps run
+  ``--rounds`` times (default 3), alternating, and the medians are compared (``runs_s``: each run).
+  ``cpu_sweep_process_s``, ``cpu_workers_s``: median CPU seconds of the sweep's own process (first
+  point, Dask scheduler, writing, figures) and of its worker processes (with the Dask nannies and
+  the process drawing half of the figures); they move much less with the load than wall times.
+* ``command_line``: the same three sweeps as whole commands, as a user runs them
+  (``python -m clutchocp.cli sweep zhang2021 --grid ... --workers N``: interpreter start, imports,
+  the sweep, figures and summary), alternating, medians: ``parallel_efficiency`` and
+  ``dask_over_local`` of the wall times.
 * ``runs_per_second_per_core``: points per second per worker of the 2-worker local sweep.
 * ``reused_model_share_vm``, ``reused_model_share_native``: per engagement scene, the share of a
   point's time spent outside the IDAS calls in a sweep that reuses one model per worker (the
@@ -64,12 +72,25 @@ def rows_of(folder):
         return [{k: v if k in TEXT_COLUMNS else parse_cell(v) for k, v in r.items()} for r in csv.DictReader(fh)]
 
 
+def cpu_s():
+    """CPU seconds (user + system) of this process and of its finished child processes."""
+    import resource
+
+    return tuple(sum(getattr(resource.getrusage(who), a) for a in ("ru_utime", "ru_stime"))
+                 for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+
+
+CPU = {}        # name of a timed sweep -> (CPU of this process, CPU of its workers) [s]
+
+
 def timed_sweep(work, name, **kw):
     folder = Path(work) / name
     clear_caches()                       # this process's models from earlier sweeps: built again, timed
+    cpu = cpu_s()
     start = time.perf_counter()
     summary = run_sweep(out_dir=folder, progress=False, **kw)
     wall = time.perf_counter() - start
+    CPU[name] = tuple(b - a for a, b in zip(cpu, cpu_s()))
     if summary["points_ok"] != summary["points"]:
         raise RuntimeError(f"{name}: {summary['points_failed']} points failed: {summary['failures'][:2]}")
     return wall, summary, rows_of(folder)
@@ -81,23 +102,55 @@ def zhang_grid(points):
     return [f"actuation.pressure=0.3 MPa:0.6 MPa:{n_pressure}", f"oil.viscosity=0.04:0.08:{n_viscosity}"]
 
 
-def parallel(work, points, options=None):
+def parallel(work, points, options=None, rounds=3):
     grid = zhang_grid(points)
-    out = {"points": None, "load_before": load()}
+    out = {"points": None, "rounds": rounds, "load_before": load()}
     # the compiled C of the sweep's model is built once per machine (disk cache): build it before timing
     warm = [f"{g.rsplit(':', 1)[0]}:2" for g in grid]
     out["native_first_build_s"] = timed_sweep(work, "warmup", scene="zhang2021", grid=warm, engine="serial")[0]
-    t1, s1, _ = timed_sweep(work, "local1", scene="zhang2021", grid=grid, engine="local", workers=1,
-                               options=options)
-    t2, s2, _ = timed_sweep(work, "local2", scene="zhang2021", grid=grid, engine="local", workers=2,
-                               options=options)
-    td, sd, _ = timed_sweep(work, "dask2", scene="zhang2021", grid=grid, engine="dask", workers=2,
-                               options=options)
-    out.update(points=s2["points"], local_1_worker_s=t1, local_2_workers_s=t2, dask_2_workers_s=td,
+    runs = {"local1": dict(engine="local", workers=1), "local2": dict(engine="local", workers=2),
+            "dask2": dict(engine="dask", workers=2)}
+    wall, inner, cpu = {k: [] for k in runs}, {k: [] for k in runs}, {k: [] for k in runs}
+    for r in range(rounds):                 # side by side, alternating: the load changes from minute to minute
+        for name, kw in runs.items():
+            t, s, _ = timed_sweep(work, f"{name}_{r}", scene="zhang2021", grid=grid, options=options, **kw)
+            wall[name].append(t)
+            inner[name].append(s["wall_time_s"])
+            cpu[name].append(CPU[f"{name}_{r}"])
+            out["points"] = s["points"]
+    t1, t2, td = (statistics.median(wall[k]) for k in runs)
+    s1, s2, sd = (statistics.median(inner[k]) for k in runs)
+    out.update(local_1_worker_s=t1, local_2_workers_s=t2, dask_2_workers_s=td,
+               runs_s={k: [round(v, 3) for v in wall[k]] for k in runs},
+               cpu_sweep_process_s={k: statistics.median(c[0] for c in cpu[k]) for k in runs},
+               cpu_workers_s={k: statistics.median(c[1] for c in cpu[k]) for k in runs},
                parallel_efficiency=t1 / (2 * t2), dask_over_local=td / t2,
-               parallel_efficiency_sweep_only=s1["wall_time_s"] / (2 * s2["wall_time_s"]),
-               dask_over_local_sweep_only=sd["wall_time_s"] / s2["wall_time_s"],
-               runs_per_second_per_core=s2["points"] / t2 / 2, load_after=load())
+               parallel_efficiency_sweep_only=s1 / (2 * s2), dask_over_local_sweep_only=sd / s2,
+               runs_per_second_per_core=out["points"] / t2 / 2, load_after=load())
+    return out
+
+
+def command_line(work, points, rounds=3):
+    """The same sweeps as whole commands (``python -m clutchocp.cli sweep``: interpreter start,
+    imports, sweep, figures), alternating; medians."""
+    import subprocess
+
+    grid = [a for g in zhang_grid(points) for a in ("--grid", g)]
+    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
+    runs = {"local1": ["--workers", "1"], "local2": ["--workers", "2"], "dask2": ["--engine", "dask", "--workers", "2"]}
+    wall = {k: [] for k in runs}
+    out = {"load_before": load()}
+    for r in range(rounds):
+        for name, extra in runs.items():
+            cmd = [sys.executable, "-m", "clutchocp.cli", "sweep", "zhang2021", *grid, *extra, "--out",
+                   str(Path(work) / f"cli_{name}_{r}")]
+            start = time.perf_counter()
+            subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            wall[name].append(time.perf_counter() - start)
+    t1, t2, td = (statistics.median(wall[k]) for k in runs)
+    out.update(local_1_worker_s=t1, local_2_workers_s=t2, dask_2_workers_s=td,
+               runs_s={k: [round(v, 3) for v in wall[k]] for k in runs},
+               parallel_efficiency=t1 / (2 * t2), dask_over_local=td / t2, load_after=load())
     return out
 
 
@@ -208,6 +261,10 @@ def target_lines(result):
     checks = (("parallel", "parallel_efficiency", ">=", TARGETS["parallel_efficiency"],
                "parallel efficiency, 2 local workers"),
               ("parallel", "dask_over_local", "<=", TARGETS["dask_over_local"], "Dask LocalCluster / local pool"),
+              ("command_line", "parallel_efficiency", ">=", TARGETS["parallel_efficiency"],
+               "whole command: parallel efficiency, 2 local workers"),
+              ("command_line", "dask_over_local", "<=", TARGETS["dask_over_local"],
+               "whole command: Dask LocalCluster / local pool"),
               ("optimize_map", "warm_over_cold", "<=", TARGETS["optimize_warm_over_cold"],
                "optimize map, warm / cold"))
     for part, key, sense, target, label in checks:
@@ -231,7 +288,9 @@ def main(argv=None):
     parser.add_argument("--map", type=int, default=5, help="optimize map size n (n x n points, default 5)")
     parser.add_argument("--model-per-point", action="store_true",
                         help="parallel part: a new model at every point (heavier points) instead of the default")
-    parser.add_argument("--skip", default="", help="comma-separated parts to skip: parallel, share, optimize")
+    parser.add_argument("--skip", default="", help="comma-separated parts to skip: parallel, cli, share, optimize")
+    parser.add_argument("--rounds", type=int, default=3,
+                        help="alternating rounds of the timed 200-point sweeps (medians; default 3)")
     args = parser.parse_args(argv)
     skip = set(filter(None, args.skip.split(",")))
     out = Path(args.out)
@@ -240,8 +299,12 @@ def main(argv=None):
     result = {"cores": os.cpu_count(), "targets": TARGETS}
     try:
         if "parallel" not in skip:
-            result["parallel"] = parallel(work, args.points, {"reuse_model": False} if args.model_per_point else None)
+            result["parallel"] = parallel(work, args.points, {"reuse_model": False} if args.model_per_point else None,
+                                          rounds=args.rounds)
             print(json.dumps(result["parallel"], indent=1), file=sys.stderr)
+        if "cli" not in skip:
+            result["command_line"] = command_line(work, args.points, rounds=args.rounds)
+            print(json.dumps(result["command_line"], indent=1), file=sys.stderr)
         if "share" not in skip:
             scenes = ("zhang2021", "bao2020", "default_driveline")
             result["outside_integrator_share"] = {s: outside_share(s) for s in scenes}

@@ -35,6 +35,20 @@ from .tasks import run_unit, warm_up
 ENGINES = ("local", "dask", "serial")
 
 
+# Dask settings of the LocalCluster a sweep starts: its periodic housekeeping off or rare. Each
+# periodic callback wakes a worker's event loop, which then waits for the GIL that the thread
+# running CasADi holds; and the scheduler runs in this process beside the workers.
+LOCAL_CLUSTER_CONFIG = {
+    # no statistical profiler (it samples each worker's stack every 10 ms for a dashboard this
+    # cluster does not have; measured: 200-point zhang2021 sweep 8.3 s without it against 9.5 s
+    # with it, load 7.5)
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",                 # event-loop health check (default 20 ms)
+    "distributed.admin.system-monitor.interval": "10s",      # CPU/memory/network sampling (500 ms)
+    "distributed.worker.memory.monitor-interval": "10s",     # worker memory checks (100 ms)
+}
+
+
 class StudyInterrupted(KeyboardInterrupt):
     """The study was stopped by Ctrl-C after ``done`` points (all of them written)."""
 
@@ -230,11 +244,7 @@ def _run_dask(task, units, deliver, workers, scheduler):
             if method == "fork":            # the forked workers inherit what the warm-up built
                 done, units = warm_up(task, units)
                 deliver(done)
-            # No statistical profiler in the workers (it samples each worker's stack every 10 ms
-            # for the dashboard, which this cluster does not have; measured: 200-point zhang2021
-            # sweep 8.3 s without it against 9.5 s with it, load 7.5).
-            with dask.config.set({"distributed.worker.multiprocessing-method": method,
-                                  "distributed.worker.profile.enabled": False}):
+            with dask.config.set({"distributed.worker.multiprocessing-method": method, **LOCAL_CLUSTER_CONFIG}):
                 cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                        dashboard_address=None)
             client = Client(cluster)

@@ -58,9 +58,8 @@ def _title(scene, task, rows):
     return f"{scene.name}: {task.kind} sweep, {len(rows)} points{failed}"
 
 
-def draw_study(out, scene, task, fields, rows, sampled, processes=1):
-    """Draw the study's figures into ``out``; returns the paths written. ``processes``: how many
-    processes may draw at once (the sweep's workers; the heat maps use two)."""
+def draw_study(out, scene, task, fields, rows, sampled):
+    """Draw the study's figures into ``out``; returns the paths written."""
     plotted = [c for c in PLOTTED[task.kind] if np.isfinite(_values(rows, c)).any()]
     files = []
     if not rows or not plotted:
@@ -73,7 +72,7 @@ def draw_study(out, scene, task, fields, rows, sampled, processes=1):
     elif len(fields) == 1 and numeric:
         files.append(_lines(out, scene, task, rows, plotted, fields[0]))
     elif len(fields) == 2 and len(numeric) == 2:
-        files.append(_maps(out, scene, task, rows, plotted, fields, processes))
+        files.append(_maps(out, scene, task, rows, plotted, fields))
     if task.kind == "optimize":
         path = _curves(out, scene, task, rows, fields)
         if path is not None:
@@ -98,40 +97,17 @@ def _lines(out, scene, task, rows, plotted, field):
     return save_figure(fig, out / "sweep_lines.png")
 
 
-# Heat-map figure geometry [inch]: panel width and height, margins, and the gap between two rows
-# of panels (it holds the upper row's x labels and the lower row's titles).
-MAP_WIDTH, MAP_PANEL_H, MAP_TOP, MAP_BOTTOM, MAP_GAP_TOP = 9.6, 2.34, 1.0, 0.58, 0.36
-MAP_DPI = 100
-
-
-def _maps(out, scene, task, rows, plotted, fields, processes=1):
-    """The heat maps, one panel per result, two per row. Each row of panels is its own figure,
-    drawn in its own process when ``processes`` > 1 (forked; the drawing is serial time at the end
-    of every sweep, 0.4 s of a 200-point one, and mostly tick labels), then stacked into one PNG."""
-    n = len(plotted)
-    parts = [(plotted[k:k + 2], k == 0) for k in range(0, n, 2)]
-    title = (_title(scene, task, rows) + "\nblank cell: no value (a failed point, or no lock-up within t_end)")
-    draw = [lambda cols=cols, top=top: _map_row(scene, rows, cols, fields, title if top else None)
-            for cols, top in parts]
-    images = _render_all(draw, processes)
-    path = out / "sweep_maps.png"
-    from PIL import Image
-
-    Image.fromarray(np.concatenate(images, axis=0)).save(path, dpi=(MAP_DPI, MAP_DPI))
-    return path
-
-
-def _map_row(scene, rows, columns, fields, title):
-    """One row of heat-map panels (the first row carries ``title``) as an RGB array."""
+def _maps(out, scene, task, rows, plotted, fields):
     xs = np.unique([r[fields[1]] for r in rows])
     ys = np.unique([r[fields[0]] for r in rows])
-    top = MAP_TOP if title else MAP_GAP_TOP
-    height = top + MAP_PANEL_H + MAP_BOTTOM
+    n = len(plotted)
     # Fixed margins, not the constrained layout: it measured every tick label twice and took 60 % of
-    # the time of a sweep's figures.
-    fig, axes = _figure(1, 2, width=MAP_WIDTH / 2, height=height, layout=None)
-    fig.subplots_adjust(left=0.12, right=0.94, bottom=MAP_BOTTOM / height, top=1 - top / height, wspace=0.55)
-    for ax, column in zip(axes, columns):
+    # the time of a sweep's figures (the drawing is serial time at the end of every sweep).
+    fig, axes = _figure(math.ceil(n / 2), min(n, 2), width=4.8, height=3.6, layout=None)
+    rows_of_axes = math.ceil(n / 2)
+    fig.subplots_adjust(left=0.12, right=0.94, bottom=0.16 / rows_of_axes, top=1 - 0.28 / rows_of_axes,
+                        wspace=0.55, hspace=0.4)
+    for ax, column in zip(axes, plotted):
         grid = np.full((ys.size, xs.size), np.nan)
         for r, v in zip(rows, _values(rows, column)):
             grid[np.searchsorted(ys, r[fields[0]]), np.searchsorted(xs, r[fields[1]])] = v
@@ -140,51 +116,11 @@ def _map_row(scene, rows, columns, fields, title):
         ax.set_xlabel(field_label(scene, fields[1]))
         ax.set_ylabel(field_label(scene, fields[0]))
         ax.set_title(result_label(column), fontsize=10)
-    for ax in axes[len(columns):]:
+    for ax in axes[n:]:
         ax.set_visible(False)
-    if title:
-        fig.suptitle(title, fontsize=11, y=1 - 0.1 / height, va="top")
-    fig.set_dpi(MAP_DPI)
-    fig.canvas.draw()
-    return np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
-
-
-def _child_render(draw, conn):
-    try:
-        conn.send(draw())
-    except BaseException as exc:            # the parent draws this part itself
-        conn.send(exc)
-    finally:
-        conn.close()
-
-
-def _render_all(draws, processes):
-    """The arrays of ``draws`` (callables), all but the first in forked processes (at most
-    ``processes`` - 1 of them) while this process draws the first; serially without fork."""
-    from .executor import start_method
-
-    extra = min(processes, len(draws)) - 1
-    if extra < 1 or start_method() != "fork":
-        return [d() for d in draws]
-    import multiprocessing
-
-    ctx = multiprocessing.get_context("fork")
-    children = []
-    for draw in draws[1:1 + extra]:
-        receive, send = ctx.Pipe(duplex=False)
-        child = ctx.Process(target=_child_render, args=(draw, send), daemon=True)
-        child.start()
-        send.close()
-        children.append((child, receive, draw))
-    images = [draws[0]()] + [None] * extra + [d() for d in draws[1 + extra:]]
-    for k, (child, receive, draw) in enumerate(children, start=1):
-        try:
-            image = receive.recv()
-        except EOFError:
-            image = None
-        child.join()
-        images[k] = image if isinstance(image, np.ndarray) else draw()
-    return images
+    fig.suptitle(_title(scene, task, rows) + "\nblank cell: no value (a failed point, or no lock-up within t_end)",
+                 fontsize=11)
+    return save_figure(fig, out / "sweep_maps.png")
 
 
 def _edges(centres):

@@ -119,9 +119,7 @@ def run_sweep(scene, out_dir, *, task="simulate", grid=(), samples=None, seed=0,
         try:
             summary = sweep_summary(base, job, fields, rows, resumed=len(done & set(order)), computed=len(todo),
                                     wall=wall, engine_info=engine_info, samples=samples, seed=seed)
-            # the figures may use this machine's sweep workers (not those of a remote cluster)
-            drawing = (engine_info.get("workers") or 1) if engine != "serial" and not scheduler else 1
-            files = draw_study(out, base, job, fields, rows, samples is not None, processes=drawing)
+            files = draw_study(out, base, job, fields, rows, samples is not None)
             files.append(write_summary(out / "summary.json", summary))
         except KeyboardInterrupt:         # Ctrl-C while drawing: every row is written, say so
             raise StudyInterrupted(len(rows), len(points)) from None

@@ -157,3 +157,10 @@ def test_on_resume_calibration_rows_of_a_point_without_its_results_row_are_dropp
     lines = (tmp_path / "s" / "calibration.csv").read_text().splitlines()
     assert lines == ["oil.viscosity,point_id,time_s,pressure_Pa", "0.02,a1,0.0,0.0", "0.02,a1,0.1,500000.0",
                      "0.02,a1,0.2,1000000.0"]
+
+
+def test_figure_axes_draw_pressures_in_mpa_and_other_fields_in_si(zhang):
+    from clutchocp.study.figures import field_axis
+
+    assert field_axis(zhang, "actuation.pressure") == ("actuation.pressure [MPa]", 1e-6)
+    assert field_axis(zhang, "oil.viscosity") == ("oil.viscosity [Pa s]", 1.0)

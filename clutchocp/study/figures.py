@@ -32,12 +32,17 @@ def result_label(column):
     return column.replace("_", " ")
 
 
-def field_label(scene, name):
-    """``"load.torque"`` -> ``"load.torque [N m]"`` (the SI unit of the scene field)."""
+DISPLAY_UNITS = {"Pa": ("MPa", 1e-6)}      # SI unit -> (unit drawn on an axis, factor)
+
+
+def field_axis(scene, name):
+    """Axis label and scale of a scene field: ``"load.torque"`` -> ``("load.torque [N m]", 1.0)``,
+    ``"actuation.pressure"`` -> ``("actuation.pressure [MPa]", 1e-6)`` (values times the scale)."""
     part, _, key = name.partition(".")
     spec = PARTS[part].allowed_fields(scene.variant(part)).get(key) if part in PARTS else None
     unit = getattr(spec, "dim", "1") if spec is not None and getattr(spec, "kind", "") == "quantity" else "1"
-    return f"{name} [{unit}]" if unit != "1" else name
+    unit, scale = DISPLAY_UNITS.get(unit, (unit, 1.0))
+    return (f"{name} [{unit}]" if unit != "1" else name), scale
 
 
 def _figure(rows, cols, width=4.2, height=3.2, layout="constrained"):
@@ -81,14 +86,15 @@ def draw_study(out, scene, task, fields, rows, sampled):
 
 
 def _lines(out, scene, task, rows, plotted, field):
-    x = np.array([r[field] for r in rows], float)
+    label, scale = field_axis(scene, field)
+    x = np.array([r[field] for r in rows], float) * scale
     order = np.argsort(x)
     n = len(plotted)
     fig, axes = _figure(math.ceil(n / 2), min(n, 2))
     for ax, column in zip(axes, plotted):
         y = _values(rows, column)
         ax.plot(x[order], y[order], "o-", color="C0")
-        ax.set_xlabel(field_label(scene, field))
+        ax.set_xlabel(label)
         ax.set_ylabel(result_label(column))
         ax.grid(True, alpha=0.3)
     for ax in axes[n:]:
@@ -100,6 +106,7 @@ def _lines(out, scene, task, rows, plotted, field):
 def _maps(out, scene, task, rows, plotted, fields):
     xs = np.unique([r[fields[1]] for r in rows])
     ys = np.unique([r[fields[0]] for r in rows])
+    (x_label, x_scale), (y_label, y_scale) = field_axis(scene, fields[1]), field_axis(scene, fields[0])
     n = len(plotted)
     # Fixed margins, not the constrained layout: it measured every tick label twice and took 60 % of
     # the time of a sweep's figures (the drawing is serial time at the end of every sweep).
@@ -111,10 +118,11 @@ def _maps(out, scene, task, rows, plotted, fields):
         grid = np.full((ys.size, xs.size), np.nan)
         for r, v in zip(rows, _values(rows, column)):
             grid[np.searchsorted(ys, r[fields[0]]), np.searchsorted(xs, r[fields[1]])] = v
-        mesh = ax.pcolormesh(_edges(xs), _edges(ys), np.ma.masked_invalid(grid), shading="flat", cmap="viridis")
+        mesh = ax.pcolormesh(_edges(xs) * x_scale, _edges(ys) * y_scale, np.ma.masked_invalid(grid),
+                             shading="flat", cmap="viridis")
         fig.colorbar(mesh, ax=ax, label=result_label(column))
-        ax.set_xlabel(field_label(scene, fields[1]))
-        ax.set_ylabel(field_label(scene, fields[0]))
+        ax.set_xlabel(x_label)
+        ax.set_ylabel(y_label)
         ax.set_title(result_label(column), fontsize=10)
     for ax in axes[n:]:
         ax.set_visible(False)
@@ -156,9 +164,10 @@ def _scatter(out, scene, task, rows, plotted, fields):
         y = _values(rows, column)
         for j, field in enumerate(fields):
             ax = axes[i, j]
-            ax.plot([r[field] for r in rows], y, ".", color="C0", ms=4)
+            label, scale = field_axis(scene, field)
+            ax.plot([r[field] * scale for r in rows], y, ".", color="C0", ms=4)
             if i == len(plotted) - 1:
-                ax.set_xlabel(field_label(scene, field))
+                ax.set_xlabel(label)
             if j == 0:
                 ax.set_ylabel(result_label(column), fontsize=8)
             ax.grid(True, alpha=0.3)
@@ -179,7 +188,8 @@ def _curves(out, scene, task, rows, fields):
     for r in table:
         by_point.setdefault(r["point_id"], []).append(r)
     colour_field = fields[0] if fields and all(isinstance(r[fields[0]], float) for r in rows) else None
-    values = [r[colour_field] for r in rows] if colour_field else [0.0]
+    colour_label, colour_scale = field_axis(scene, colour_field) if colour_field else ("", 1.0)
+    values = [r[colour_field] * colour_scale for r in rows] if colour_field else [0.0]
     lo, hi = min(values), max(values)
     fig, axes = _figure(1, 1, width=7.0, height=4.4)
     ax = axes[0]
@@ -190,10 +200,10 @@ def _curves(out, scene, task, rows, fields):
         curve = by_point.get(r["point_id"])
         if not curve:
             continue
-        colour = cm.viridis(norm(r[colour_field])) if colour_field else "C0"
+        colour = cm.viridis(norm(r[colour_field] * colour_scale)) if colour_field else "C0"
         ax.plot([c["time_s"] for c in curve], [c["pressure_Pa"] / 1e6 for c in curve], color=colour, lw=1.2)
     if colour_field:
-        fig.colorbar(cm.ScalarMappable(norm=norm, cmap="viridis"), ax=ax, label=field_label(scene, colour_field))
+        fig.colorbar(cm.ScalarMappable(norm=norm, cmap="viridis"), ax=ax, label=colour_label)
     ax.set_xlabel("time [s]")
     ax.set_ylabel("optimal pressure command [MPa]")
     ax.grid(True, alpha=0.3)

@@ -43,7 +43,8 @@ it has no holding condition (a lock that carries nothing always holds). With the
 term is the jerk of the input (the braked inertia), as the output does not move.
 
 Constraints: t_f <= t_max, E <= E_max, films h >= h_min, 0 <= u <= actuation.max_pressure,
-|du/dt| <= rate limit, w_rel >= 0; optionally interface temperature <= max_temperature_C (a scene
+|du/dt| <= rate limit, w_rel >= 0; with a spring-applied piston, films h <= their gap at the kiss
+in the slip phase (the piston not behind the kiss point, Bao Eq. 13); optionally interface temperature <= max_temperature_C (a scene
 with [thermal]) and interface heat per friction area <= max_specific_power_W_mm2 (path constraints,
 :mod:`clutchocp.optimal.heat`). The ``smooth`` term regularises the command: without it the
 command reaches the objective only through two integrations (valve lag, film) and IPOPT meets a

@@ -99,19 +99,8 @@ def phase_guess(ocp, run, k, tr, t_max=None):
         raise ModelError(f"scene '{ocp.scene.name}': the guess run never enters mode '{mode}' of the {name} phase")
     t0, t1 = windows[mode]
     t, idx = mode_samples(run, mode, t0, t1)
-    starts, points = tr.node_times(1.0)                 # normalised times s in [0, 1]
-
-    def states_at(s):
-        tau = t0 + s * (t1 - t0)
-        cols = [np.interp(tau, t, res[nm][idx]) / nominal for nm, nominal in zip(ocp.state_names, ocp.nominal)]
-        cols.append(np.interp(tau, t, energy_all[idx]) / ocp.scales.energy_J)
-        return np.stack(cols, axis=-1)
-
-    x, xc = states_at(starts), states_at(points)
-    if k == 0:
-        x[0] = np.append(ocp.x0 / ocp.nominal, 0.0)
-    s_u = 0.5 * (starts[:-1] + starts[1:]) if tr.control == "constant" else starts
-    tau_u = t0 + s_u * (t1 - t0)
+    x, xc, tau_u = _phase_nodes(ocp, tr, k, t0, t1, t, {nm: res[nm][idx] for nm in ocp.state_names},
+                                energy_all[idx])
     u = command_history(run, tau_u) if ocp.has_valve else np.interp(tau_u, t, res["pressure_Pa"][idx])
     u = np.clip(u, 0.0, ocp.p_max) / ocp.scales.pressure_Pa
     return x, xc, u, squeeze * (t1 - t0) / ocp.scales.time_s
@@ -126,22 +115,10 @@ def guess_from_optimum(ocp, opt, t_max=None):
     for k, phase in enumerate(opt.phases):
         part = ocp.phased.parts[k]
         tr = part.transcription
-        starts, points = tr.node_times(1.0)
         a, b = phase["nodes"]
         t0, t1 = phase["t_start_s"], phase["t_end_s"]
-        t_old = (opt.t[a:b] - t0) / (t1 - t0)
-
-        def states_at(s, a=a, b=b, t_old=t_old):
-            cols = [np.interp(s, t_old, opt.states[nm][a:b]) / nominal
-                    for nm, nominal in zip(ocp.state_names, ocp.nominal)]
-            cols.append(np.interp(s, t_old, opt.outputs["dissipated_energy_J"][a:b]) / ocp.scales.energy_J)
-            return np.stack(cols, axis=-1)
-
-        x, xc = states_at(starts), states_at(points)
-        if k == 0:
-            x[0] = np.append(ocp.x0 / ocp.nominal, 0.0)
-        s_u = 0.5 * (starts[:-1] + starts[1:]) if tr.control == "constant" else starts
-        tau_u = t0 + s_u * (t1 - t0)
+        states = {nm: opt.states[nm][a:b] for nm in ocp.state_names}
+        x, xc, tau_u = _phase_nodes(ocp, tr, k, t0, t1, opt.t[a:b], states, opt.outputs["dissipated_energy_J"][a:b])
         if opt.control == "constant":
             u = opt.command[np.clip(np.searchsorted(opt.command_times, tau_u, side="right") - 1, 0,
                                     opt.command.size - 1)]
@@ -150,3 +127,22 @@ def guess_from_optimum(ocp, opt, t_max=None):
         u = np.clip(u, 0.0, ocp.p_max) / ocp.scales.pressure_Pa
         pieces.append(part.pack(x, xc, u[:, None], squeeze * (t1 - t0) / ocp.scales.time_s))
     return np.concatenate(pieces)
+
+
+def _phase_nodes(ocp, tr, k, t0, t1, t, states, energy):
+    """Scaled node states (N + 1, n_x + 1) and collocation states (N, d, n_x + 1) of phase k on the
+    mesh of ``tr``, interpolated from samples ``states`` {name: values} and dissipated ``energy`` [J]
+    at times ``t`` [s] over the phase [t0, t1]; and the command times [s] of the phase."""
+    starts, points = tr.node_times(1.0)                 # normalised times s in [0, 1]
+
+    def states_at(s):
+        tau = t0 + s * (t1 - t0)
+        cols = [np.interp(tau, t, states[nm]) / nominal for nm, nominal in zip(ocp.state_names, ocp.nominal)]
+        cols.append(np.interp(tau, t, energy) / ocp.scales.energy_J)
+        return np.stack(cols, axis=-1)
+
+    x, xc = states_at(starts), states_at(points)
+    if k == 0:
+        x[0] = np.append(ocp.x0 / ocp.nominal, 0.0)
+    s_u = 0.5 * (starts[:-1] + starts[1:]) if tr.control == "constant" else starts
+    return x, xc, t0 + s_u * (t1 - t0)

@@ -1,8 +1,8 @@
 """The closed loop on the hardest clutches: slip feedback run on the corners of the uncertainty box.
 
 A development check of the slip feedback that takes about a minute instead of the Monte Carlo's
-ten: on the default scene it solves the nominal optimum (the closed loop's feedforward, optionally
-with a time margin: ``--t-max-fraction``), designs the slip feedback of a spec, and runs the closed
+ten: on the default scene it solves the nominal optimum, designs the slip feedback of a spec as ``clutchocp
+robust`` does (the feedforward with the spec's time margin, scheduled on the spec's field), and runs the closed
 loop through IDAS on the nominal clutch and on the 2^3 corners of the scene's [uncertainty] box
 (mu +-10 %, viscosity +-30 %, load torque +-20 %), or on ``--samples`` random draws instead. Per
 clutch it prints the lock-up time (and whether it is within t_max, with the 1 % lock-time tolerance
@@ -11,7 +11,7 @@ optimum's (at t_max), and the largest feedback correction [kPa].
 
 Run from the repository root:
 
-    python benchmarks/bench_slip_corners.py [--t-max-fraction 1.0] [--controller slip_lqr] [--samples N]
+    python benchmarks/bench_slip_corners.py [--controller slip_lqr] [--samples N]
 """
 
 import argparse
@@ -24,15 +24,13 @@ from clutchocp.optimal.problem import EngagementOCP
 from clutchocp.optimal.verify import LOCK_TIME_TOLERANCE, run_numbers
 from clutchocp.scene import default_scene
 from clutchocp.shiftcontrol.closed_loop import run_closed_loop
-from clutchocp.shiftcontrol.design import design_slip_feedback
+from clutchocp.shiftcontrol.schedule import design_schedule
 from clutchocp.shiftcontrol.spec import load_slip_spec
 from clutchocp.uncertainty import Uncertainty
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--t-max-fraction", type=float, default=1.0,
-                        help="the feedforward is the nominal optimum solved with t_max x this (default 1)")
     parser.add_argument("--controller", default="slip_lqr", help="slip-feedback spec name or TOML file")
     parser.add_argument("--samples", type=int, default=0, help="random draws (seed --seed) instead of the corners")
     parser.add_argument("--seed", type=int, default=0)
@@ -42,14 +40,21 @@ def main():
     scene = default_scene()
     uncertainty = Uncertainty.from_scene(scene)
     nominal = scene.without_uncertainty()
+    spec = load_slip_spec(args.controller)
     ocp = EngagementOCP(nominal, intervals=args.intervals)
     t_max = ocp.default_t_max()
     start = time.perf_counter()
     opt = ocp.solve(t_max=t_max)
-    ff = opt if args.t_max_fraction >= 1 else ocp.solve(t_max=args.t_max_fraction * t_max, guess=opt)
-    design = design_slip_feedback(nominal, ff.command_times, ff.command, load_slip_spec(args.controller))
-    print(f"t_max {t_max:.4f} s; feedforward locks at {ff.t_f:.4f} s ({args.t_max_fraction:g} x t_max); "
-          f"set-up {time.perf_counter() - start:.1f} s; load {os.getloadavg()[0]:.1f}")
+
+    def feedforward_for(design_scene):      # as clutchocp robust: the design scene's optimum at the spec's margin
+        found = EngagementOCP(design_scene, intervals=args.intervals).solve(t_max=spec.t_max_fraction * t_max)
+        return found.command_times, found.command
+
+    schedule = design_schedule(nominal, spec, uncertainty, feedforward_for, say=lambda *a: None)
+    print(f"t_max {t_max:.4f} s; feedforwards lock at {', '.join(f'{t:.4f}' for t in schedule.lock_times)} s "
+          f"({spec.t_max_fraction:g} x t_max, {len(schedule.feedbacks)} design(s) on "
+          f"{schedule.field or 'the nominal scene'}); set-up {time.perf_counter() - start:.1f} s; "
+          f"load {os.getloadavg()[0]:.1f}")
     if args.samples:
         cases = [(f"s{i}", d) for i, d in enumerate(uncertainty.samples(args.samples, seed=args.seed))]
     else:
@@ -62,7 +67,8 @@ def main():
           f"{'jerk/opt':>8} {'max du [kPa]':>12}")
     for name, overrides in cases:
         clutch = nominal.with_overrides(overrides)
-        run, tcu = run_closed_loop(clutch, design.feedback, t_end, nominal_scene=nominal)
+        feedback, design = schedule.select(clutch)
+        run, tcu = run_closed_loop(clutch, feedback, t_end, nominal_scene=nominal.with_overrides(design))
         n = run_numbers(run)
         t_lock = n["engagement_time_s"]
         ok = t_lock is not None and t_lock <= t_max * (1 + LOCK_TIME_TOLERANCE)

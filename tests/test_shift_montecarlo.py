@@ -5,6 +5,7 @@ import json
 import numpy as np
 import pytest
 
+from clutchocp.errors import SceneError
 from clutchocp.scene import default_scene
 from clutchocp.shiftcontrol.montecarlo import Strategy, parallel_map, run_sample, strategy_statistics
 from clutchocp.shiftcontrol.report import run_robust
@@ -65,6 +66,7 @@ def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch)
     """Plumbing only: a stand-in for clutchocp.optimal.robust.solve_robust (contract: one shared command,
     per-scenario lock times) returns the nominal optimum; the strategy list must pick it up, and the
     closed loop's feedforward when the spec asks for the robust curve."""
+    from dataclasses import replace
     from types import SimpleNamespace
 
     from clutchocp.optimal.problem import EngagementOCP
@@ -81,7 +83,7 @@ def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch)
                                scenarios=[opt], stats={"status": "stand-in"})
 
     monkeypatch.setattr(report, "robust_solver", lambda: stand_in)
-    spec = load_slip_spec()
+    spec = replace(load_slip_spec(), t_max_fraction=1.0, schedule_field="")
     strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene),
                                                 spec, intervals=30, say=lambda *a: None)
     assert [s.name for s in strategies] == ["baseline", "nominal_optimum", "robust_feedforward", "closed_loop"]
@@ -104,7 +106,7 @@ def test_closed_loop_tracks_a_feedforward_with_a_time_margin_when_asked(monkeypa
 
     monkeypatch.setattr(report, "robust_solver", lambda: None)
     scene = default_scene()
-    spec = replace(load_slip_spec(), t_max_fraction=0.9)
+    spec = replace(load_slip_spec(), t_max_fraction=0.9, schedule_field="")
     strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene), spec,
                                                 intervals=30, say=lambda *a: None)
     t_max = facts["t_max_s"]
@@ -114,3 +116,36 @@ def test_closed_loop_tracks_a_feedforward_with_a_time_margin_when_asked(monkeypa
     assert "0.9 x t_max" in strategies[2].label
     # the IDAS replay of the tighter optimum locks where the collocation put it, within the lock-time tolerance
     assert facts["closed_loop"]["nominal_lock_s"] == pytest.approx(0.9 * t_max, rel=0.01)
+
+
+def test_closed_loop_is_scheduled_on_the_oil_viscosity(monkeypatch):
+    """[schedule] field = "oil.viscosity", points = 3: one feedforward and feedback per viscosity at the
+    ends and the centre of the scene's spread, each an optimum locking at t_max_fraction x t_max on its
+    own scene; a clutch gets the design of the nearest viscosity."""
+    from dataclasses import replace
+
+    from clutchocp.shiftcontrol import report
+    from clutchocp.shiftcontrol.spec import load_slip_spec
+
+    monkeypatch.setattr(report, "robust_solver", lambda: None)
+    scene = default_scene()
+    nominal = scene.without_uncertainty()
+    spec = replace(load_slip_spec(), schedule_points=3)
+    strategies, facts = report.build_strategies(nominal, Uncertainty.from_scene(scene), spec, intervals=30,
+                                                say=lambda *a: None)
+    eta = nominal.value("oil.viscosity")
+    schedule = strategies[-1].feedback
+    assert facts["closed_loop"]["schedule"]["values"] == pytest.approx([0.7 * eta, eta, 1.3 * eta])
+    for t_lock in facts["closed_loop"]["schedule"]["lock_times_s"]:
+        assert t_lock == pytest.approx(spec.t_max_fraction * facts["t_max_s"], rel=0.01)
+    assert schedule.index(nominal.with_overrides({"oil.viscosity": 0.8 * eta})) == 0
+    assert schedule.index(nominal.with_overrides({"oil.viscosity": 1.1 * eta})) == 1
+    feedback, overrides = schedule.select(nominal.with_overrides({"oil.viscosity": 1.29 * eta}))
+    assert feedback is schedule.feedbacks[2] and overrides == {"oil.viscosity": pytest.approx(1.3 * eta)}
+    # without the field in the uncertainty there is no grid: one design, on the nominal scene
+    from clutchocp.shiftcontrol.schedule import schedule_values
+    others = Uncertainty([s for s in Uncertainty.from_scene(scene).spreads if s.key != "oil.viscosity"])
+    assert schedule_values(nominal, spec, others) == []
+    assert schedule_values(nominal, replace(spec, schedule_points=1), Uncertainty.from_scene(scene)) == []
+    with pytest.raises(SceneError, match=r"schedule\.field = 'oil\.viscosty': the scene 'default_driveline' has no"):
+        schedule_values(nominal, replace(spec, schedule_field="oil.viscosty"), Uncertainty.from_scene(scene))

@@ -13,9 +13,13 @@ def test_builtin_spec_loads_with_units():
     spec = load_slip_spec("slip_lqr")
     assert spec.sample_time == pytest.approx(0.01)
     assert spec.max_delay == pytest.approx(0.05)
-    assert spec.anti_windup == "clamping" and spec.progress == "slip"
-    assert spec.lqi["slip_tolerance"] == pytest.approx(0.003)
-    assert spec.t_max_fraction == 1.0
+    assert spec.anti_windup == "clamping" and spec.progress == "time"
+    assert spec.lqi["slip_tolerance"] == pytest.approx(0.03)
+    assert spec.t_max_fraction == pytest.approx(0.98)
+    assert spec.estimator == {"enabled": True, "activation": 0.5, "gain_limit": 1.5, "filter_time": pytest.approx(0.02)}
+    assert (spec.schedule_field, spec.schedule_points) == ("oil.viscosity", 5)
+    bare = parse_slip_spec(GOOD)            # without the tables: no estimator, no schedule
+    assert not bare.estimator["enabled"] and bare.schedule_field == "" and bare.schedule_points == 1
     assert parse_slip_spec({**GOOD, "feedforward": {"t_max_fraction": 0.85}}).t_max_fraction == pytest.approx(0.85)
     assert spec.feedforward_curve == "nominal"
     assert parse_slip_spec({**GOOD, "feedforward": {"curve": "robust"}}).feedforward_curve == "robust"
@@ -37,6 +41,16 @@ def test_builtin_spec_loads_with_units():
     ({**GOOD, "feedforward": {"t_max_fraction": 0}}, r"feedforward\.t_max_fraction = 0: must be > 0"),
     ({**GOOD, "feedforward": {"curve": "best"}}, r"feedforward\.curve.*nominal, robust"),
     ({**GOOD, "feedforward": {"t_max_fracton": 0.9}}, r"feedforward\.t_max_fracton: unknown key .*did you mean 't_max_fraction'"),
+    ({**GOOD, "estimator": {"activation": 1.5}}, r"estimator\.activation = 1\.5: must be in \(0, 1\)"),
+    ({**GOOD, "estimator": {"gain_limit": 0.8}}, r"estimator\.gain_limit = 0\.8: must be above 1"),
+    ({**GOOD, "estimator": {"filter_time": "-5 ms"}}, r"estimator\.filter_time"),
+    ({"controller": {**GOOD["controller"], "measure_pressure": False}, "estimator": {"enabled": True}},
+     r"estimator\.enabled = true needs controller\.measure_pressure = true"),
+    ({**GOOD, "schedule": {"points": 2.5}}, r"schedule\.points = 2\.5: must be a whole number from 1 to 25"),
+    ({**GOOD, "schedule": {"points": 0}}, r"schedule\.points = 0: must be > 0"),
+    ({**GOOD, "schedule": {"field": "oil.viscosity"}, "feedforward": {"curve": "robust"}},
+     r"schedule\.field = 'oil\.viscosity' needs feedforward\.curve = \"nominal\""),
+    ({**GOOD, "schedule": {"feild": "oil.viscosity"}}, r"schedule\.feild: unknown key .*did you mean 'field'"),
 ])
 def test_bad_specs_raise_one_line(raw, match):
     with pytest.raises(SceneError, match=match) as info:

@@ -83,7 +83,8 @@ def run_closed_loop(scene, feedback, t_end, *, nominal_scene=None, model=None, r
     -------
     (EngagementResult, dict)
         The stitched run and the TCU record: ``t`` [s], ``command_Pa``, ``correction_Pa``,
-        ``command_unsat_Pa``, ``integral_rad`` per sample, and ``handover_s`` (None if it never locked).
+        ``command_unsat_Pa``, ``integral_rad``, ``scale`` and ``shift_Pa`` (the
+        feedforward adaptation's, 1 and 0 without it) per sample, and ``handover_s`` (None if it never locked).
     """
     start = time.perf_counter()
     model = model or CommandModel(scene, "linear")
@@ -94,7 +95,7 @@ def run_closed_loop(scene, feedback, t_end, *, nominal_scene=None, model=None, r
     x = dict(zip(eng.state_names, eng.initial_state))
     mode = eng.initial_mode()
     segments, events, record = [], [], {k: [] for k in ("t", "command_Pa", "correction_Pa", "command_unsat_Pa",
-                                                       "integral_rad")}
+                                                       "integral_rad", "scale", "shift_Pa")}
     handover = None
     k = 0
     t = 0.0
@@ -107,6 +108,8 @@ def run_closed_loop(scene, feedback, t_end, *, nominal_scene=None, model=None, r
             record["correction_Pa"].append(du)
             record["command_unsat_Pa"].append(u_unsat)
             record["integral_rad"].append(feedback.integral)
+            record["scale"].append(feedback.scale)
+            record["shift_Pa"].append(feedback.shift_Pa)
         if mode.endswith("locked") or feedback.finished:
             # hand over to the clamp ramp, from the command the TCU applies now
             u_now = feedback.feedforward(t - feedback.shift) + (record["correction_Pa"][-1] if record["t"] else 0.0)

@@ -8,12 +8,14 @@ that both carry the same half-sample lag). With dy the deviations and xi the int
 error e = w_rel - w_rel*:
 
     du_unsat = -K_y[k] dy - k_xi[k] xi
-    u        = clip(u_ff(t_k) + du_unsat, p_min, p_max), then |u - u[k-1]| <= rate limit x Ts
+    u        = clip(s_k (u_ff(t_k) + du_unsat) + d_k, p_min, p_max), then |u - u[k-1]| <= rate limit x Ts
     xi      <- xi + Ts e          (not while saturated in the direction e would push: clamping)
 
 and the plant receives u_ff(t) + du[k] over [t_k, t_k + Ts) (du = u - u_ff(t_k) held; the
 feedforward stays continuous so that with du = 0 the plant sees exactly the open-loop command; the
-limits are enforced at the sample instants). After the nominal lock-up time the reference is the
+limits are enforced at the sample instants). s_k = 1, d_k = 0 without adaptation; with it, the
+scale and shift of :class:`~clutchocp.shiftcontrol.estimator.FeedforwardAdaptation` (the clutch's
+torque gain and load estimated from the last two samples). After the nominal lock-up time the reference is the
 locked state (zero slip and slip rate) and the last gains hold.
 """
 
@@ -56,10 +58,14 @@ class SlipFeedback:
     max_delay : float
         The reference time never lags the clock by more than this [s]: a slow clutch is then pushed
         along in time (the slip error and its integral act).
+    adaptation : clutchocp.shiftcontrol.estimator.FeedforwardAdaptation, optional
+        Given, the command before the limits is scale (u_ff + du) + shift, with the scale and shift
+        that make the clutch met give the nominal slip path (its torque gain and load estimated from
+        the speeds and pressure of the last two samples).
     """
 
     def __init__(self, sample_time, gains, integral_gains, reference, slip_reference, measured, feedforward,
-                 p_min, p_max, rate_limit, anti_windup="clamping", path=None, max_delay=np.inf):
+                 p_min, p_max, rate_limit, anti_windup="clamping", path=None, max_delay=np.inf, adaptation=None):
         self.Ts = float(sample_time)
         self.gains = np.atleast_2d(np.asarray(gains, float))
         self.integral_gains = np.asarray(integral_gains, float).ravel()
@@ -80,6 +86,7 @@ class SlipFeedback:
         self.enabled = True
         self.path = None if path is None else tuple(np.asarray(a, float) for a in path)
         self.max_delay = float(max_delay)
+        self.adaptation = adaptation
         self.reset()
 
     @property
@@ -93,7 +100,9 @@ class SlipFeedback:
         self.progress = 0.0
         self._last_t = 0.0
         self._previous_slip = None
+        self._previous_signals = None
         self._previous_command = None
+        self.scale, self.shift_Pa = 1.0, 0.0
 
     def feedforward(self, t):
         """Feedforward command at time t [Pa] (piecewise linear, the last value held)."""
@@ -145,10 +154,21 @@ class SlipFeedback:
         u_ff = self.feedforward(tau)
         ref, slip_ref = self._reference(tau)
         rate = (w_rel - self._previous_slip) / self.Ts if self._previous_slip is not None else None
+        if self.adaptation is not None and self.enabled:
+            row = self._at(self.adaptation.nominal, tau)
+            scale, shift = self.adaptation.correction(row, self._previous_signals, signals)
+            if scale != 1.0 or shift != 0.0 or self.scale == 1.0:
+                blend = self.Ts / (self.Ts + self.adaptation.filter_time)
+                self.scale += blend * (scale - self.scale)
+                self.shift_Pa += blend * (shift - self.shift_Pa)
         y = []
         for j, name in enumerate(self.measured):
             if name == "slip_rate":
                 y.append(ref[j] if rate is None else rate)        # first sample: no difference yet
+            elif name == "p_valve":
+                # the pressure the nominal clutch would need for the same torque: the LQI acts on the
+                # adapted clutch as on the nominal one
+                y.append((signals[name] - self.shift_Pa) / self.scale)
             else:
                 y.append(signals[name])
         dy = np.asarray(y) - ref
@@ -156,7 +176,7 @@ class SlipFeedback:
         gain = self._at(self.gains, min(tau, (self.horizon - 1) * self.Ts))
         k_xi = float(self._at(self.integral_gains[:, None], min(tau, (self.horizon - 1) * self.Ts))[0])
         du_unsat = -float(gain @ dy) - k_xi * self.integral if self.enabled else 0.0
-        u_unsat = u_ff + du_unsat
+        u_unsat = self.scale * (u_ff + du_unsat) + self.shift_Pa
         u = min(max(u_unsat, self.p_min), self.p_max)
         if self._previous_command is not None:
             reach = self.rate_limit * self.Ts
@@ -167,6 +187,7 @@ class SlipFeedback:
             increment = 0.0
         self.integral += increment
         self._previous_slip = w_rel
+        self._previous_signals = dict(signals)
         self._previous_command = u
         return u - u_ff, u, u_unsat
 

@@ -28,6 +28,7 @@ from ..errors import ModelError
 from ..optimal.guess import SLIP_MODE
 from ..optimal.replay import CommandModel, simulate_command
 from .controller import SlipFeedback
+from .estimator import FeedforwardAdaptation, TorqueEstimator
 from .linearize import SlipLinearization
 from .tvlqr import tvlqr
 
@@ -193,7 +194,32 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
         peak = int(np.argmax(w_slip))
         fall = slice(peak, None)
         path = (np.append(t_slip[fall], t_lock), np.append(w_slip[fall], 0.0))
+    adaptation = _adaptation(scene, spec, sample_times[:N], state_at, lin.all_states) if spec.estimator["enabled"] \
+        else None
     feedback = SlipFeedback(Ts, gains, K[:, 0, n], ref, slip_ref, measured, (times, values), p_lo, p_hi,
                             (p_hi - p_lo) / spec.rate_limit_time, spec.anti_windup, path=path,
-                            max_delay=spec.max_delay)
+                            max_delay=spec.max_delay, adaptation=adaptation)
     return SlipFeedbackDesign(feedback, nominal, t_lock, sample_times, Phi, Gamma, K, P, lin.state_names, spec)
+
+
+def _adaptation(scene, spec, sample_times, state_at, state_names):
+    """The feedforward adaptation: the estimator's values on the nominal trajectory at the TCU samples before lock-up.
+
+    Row k of the table is the estimate over the sample ending at t_k, as the TCU computes it on the nominal
+    clutch (rows 0 and N repeat their neighbours: no estimate exists before t_1, and the TCU hands over at the
+    first sample after lock-up).
+    """
+    missing = [name for name in ("w_in", "w_out", "p_valve") if name not in state_names]
+    if missing:
+        raise ModelError(f"estimator.enabled = true: the scene's model has no {', '.join(missing)} state "
+                         "(the estimator needs both rotor speeds and the valve pressure: actuation.model = \"valve_lag\")")
+    estimator = TorqueEstimator.from_scene(scene, spec.sample_time)
+    states = np.array([state_at(t) for t in sample_times])
+    columns = [states[:, state_names.index(name)] for name in ("w_in", "w_out", "p_valve")]
+    rows = np.column_stack(estimator.along(*columns)) if len(sample_times) > 1 else np.zeros((0, 3))
+    if rows.shape[0] == 0:
+        raise ModelError("estimator.enabled = true: the nominal engagement locks within one TCU sample; nothing to adapt")
+    table = np.vstack([rows[:1], rows, rows[-1:]])
+    activation = spec.estimator["activation"] * float(np.max(rows[:, 0]))
+    return FeedforwardAdaptation(estimator, table, activation, spec.estimator["gain_limit"],
+                                 spec.estimator["filter_time"])

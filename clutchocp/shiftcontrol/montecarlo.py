@@ -33,7 +33,8 @@ class Strategy:
     """A shift-control strategy as plain data.
 
     ``times``/``values``: the command [s], [Pa] (open loop, piecewise linear, last value held);
-    ``feedback``: a SlipFeedback (closed loop; its feedforward inside).
+    ``feedback``: a :class:`~clutchocp.shiftcontrol.schedule.FeedbackSchedule` (closed loop: the slip
+    feedback designed for the clutch's value of the scheduled field, its feedforward inside).
     """
 
     name: str
@@ -67,7 +68,9 @@ def run_sample(task):
     rows = []
     for strategy in task["strategies"]:
         if strategy.feedback is not None:
-            run, _ = run_closed_loop(scene, strategy.feedback, task["t_end"], nominal_scene=nominal, model=model)
+            feedback, design = strategy.feedback.select(scene)
+            run, _ = run_closed_loop(scene, feedback, task["t_end"], nominal_scene=_scene(task, design) if design
+                                     else nominal, model=model)
         else:
             run = run_open_loop(scene, strategy.times, strategy.values, task["t_end"], model=model)
         rows.append(_row(task, strategy, run, grid))

@@ -23,8 +23,9 @@ from ..output import new_figure, save_figure, write_csv, write_summary
 from ..scene import default_scene, load_scene
 from ..uncertainty import Uncertainty
 from .closed_loop import post_lock_command
-from .design import design_slip_feedback, pressure_limits
+from .design import pressure_limits
 from .montecarlo import HISTORY_STEP, Strategy, parallel_map, run_sample, strategy_statistics
+from .schedule import design_schedule
 from .spec import load_slip_spec
 
 ACCEPTANCE = {"closed_loop_jump_p95_pct": 3.0, "closed_loop_jump_worst_pct": 6.0, "closed_loop_jerk_ratio": 1.15,
@@ -118,23 +119,40 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
                                                  if isinstance(v, (bool, int, float, str))}}
     if spec.feedforward_curve == "robust" and rob is None:
         say("  feedforward.curve = 'robust' but no robust feedforward converged: the loop tracks the nominal optimum")
-    if feedforward[0] == "nominal_optimum" and spec.t_max_fraction < 1.0:
+    margin = feedforward[0] == "nominal_optimum" and spec.t_max_fraction < 1.0
+    if margin:
         # the loop tracks a nominal optimum that locks with a time margin, so that
         # a slower clutch can still lock within t_max (feedforward.t_max_fraction of the spec)
-        t_ff = spec.t_max_fraction * t_max
-        say(f"  nominal optimum for the closed loop at {spec.t_max_fraction:g} x t_max = {t_ff:.4g} s")
-        tight = ocp.solve(t_max=t_ff, guess=opt)
-        feedforward = ("nominal_optimum_with_margin", tight.command_times, tight.command)
-    ff_label = feedforward[0].replace("_", " ") + (f" ({spec.t_max_fraction:g} x t_max)"
-                                                   if feedforward[0] == "nominal_optimum_with_margin" else "")
-    say(f"  slip feedback on the {ff_label}: {spec.label}, Ts = {spec.sample_time * 1e3:g} ms")
-    design = design_slip_feedback(scene, feedforward[1], feedforward[2], spec)
+        say(f"  nominal optimum for the closed loop at {spec.t_max_fraction:g} x t_max = "
+            f"{spec.t_max_fraction * t_max:.4g} s")
+        feedforward = ("nominal_optimum_with_margin",) + feedforward[1:]
+    ff_label = feedforward[0].replace("_", " ") + (f" ({spec.t_max_fraction:g} x t_max)" if margin else "")
+
+    def feedforward_for(design_scene):
+        # the closed loop's feedforward on a design scene: the curve chosen above on the nominal scene,
+        # else the nominal optimum of the design scene (same t_max and margin)
+        if feedforward[0] == "robust_feedforward":
+            return feedforward[1], feedforward[2]
+        same = design_scene is scene
+        problem = ocp if same else EngagementOCP(design_scene, intervals=intervals)
+        if same and not margin:
+            return opt.command_times, opt.command
+        found = problem.solve(t_max=spec.t_max_fraction * t_max, guess=opt if same else None)
+        return found.command_times, found.command
+
+    say(f"  slip feedback on the {ff_label}: {spec.label}, Ts = {spec.sample_time * 1e3:g} ms"
+        + (f", scheduled on {spec.schedule_field} ({spec.schedule_points} points)" if spec.schedule_field else ""))
+    schedule = design_schedule(scene, spec, uncertainty, feedforward_for, say=say)
     strategies.append(Strategy("closed_loop", f"slip feedback on {ff_label}",
-                               feedback=design.feedback, notes={"feedforward": feedforward[0]}))
+                               feedback=schedule, notes={"feedforward": feedforward[0]}))
     facts["closed_loop"] = {"feedforward": feedforward[0], "feedforward_t_max_fraction": spec.t_max_fraction,
-                            "controller": spec.label,
-                            "sample_time_s": spec.sample_time, "nominal_lock_s": design.t_lock,
-                            "progress": spec.progress, "measured": list(design.feedback.measured)}
+                            "controller": spec.label, "sample_time_s": spec.sample_time,
+                            "nominal_lock_s": schedule.lock_times[schedule.index(scene)],
+                            "progress": spec.progress, "measured": list(schedule.feedbacks[0].measured),
+                            "estimator": bool(spec.estimator["enabled"]),
+                            "schedule": {"field": schedule.field, "values": [float(v) for v in schedule.values
+                                                                             if np.isfinite(v)],
+                                         "lock_times_s": schedule.lock_times}}
     return strategies, facts
 
 

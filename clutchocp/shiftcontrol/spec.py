@@ -23,9 +23,18 @@ field::
     [anti_windup]
     method = "clamping"              # or "none"
 
+    [estimator]                      # the command rescaled to the clutch met (torque gain and load from the speeds)
+    enabled = true
+    activation = 0.3                 # from when the nominal clutch torque reaches this fraction of its peak
+    gain_limit = 1.5                 # largest ratio of nominal to estimated torque gain (and its inverse)
+
     [feedforward]
     curve = "nominal"                # the curve the loop tracks: "nominal" optimum or "robust" feedforward
     t_max_fraction = 1.0             # the nominal optimum is solved with t_max x this (a time margin)
+
+    [schedule]                       # the TCU measures this field (the oil viscosity, from its temperature)
+    field = "oil.viscosity"          # feedforward and gains designed at `points` values over its spread
+    points = 5
 """
 
 from dataclasses import dataclass, field
@@ -60,8 +69,12 @@ _LQI = {
     "terminal_weight": ("1", "nonnegative", 10.0),
 }
 _ANTI_WINDUP = {"method": ("choice", ANTI_WINDUP, "clamping")}
+_ESTIMATOR = {"enabled": ("bool", None, False), "activation": ("1", "positive", 0.3),
+              "gain_limit": ("1", "positive", 1.5), "filter_time": ("s", "nonnegative", 0.0)}
 _FEEDFORWARD = {"curve": ("choice", CURVES, "nominal"), "t_max_fraction": ("1", "positive", 1.0)}
-_TABLES = {"controller": _CONTROLLER, "lqi": _LQI, "anti_windup": _ANTI_WINDUP, "feedforward": _FEEDFORWARD}
+_SCHEDULE = {"field": ("str", None, ""), "points": ("1", "positive", 1.0)}
+_TABLES = {"controller": _CONTROLLER, "lqi": _LQI, "anti_windup": _ANTI_WINDUP, "estimator": _ESTIMATOR,
+           "feedforward": _FEEDFORWARD, "schedule": _SCHEDULE}
 _REQUIRED = ("type", "sample_time")
 
 
@@ -80,8 +93,11 @@ class SlipControlSpec:
     max_delay: float = 0.05
     lqi: dict = field(default_factory=lambda: {k: v[2] for k, v in _LQI.items()})
     anti_windup: str = "clamping"
+    estimator: dict = field(default_factory=lambda: {k: v[2] for k, v in _ESTIMATOR.items()})
     feedforward_curve: str = "nominal"
     t_max_fraction: float = 1.0
+    schedule_field: str = ""
+    schedule_points: int = 1
     path: Path | None = None
 
     @property
@@ -125,9 +141,29 @@ def parse_slip_spec(raw):
         raise PhysicalRangeError(f"feedforward.t_max_fraction = {fraction:g}: must be in (0, 1] (the closed loop's "
                                  "feedforward locks at this fraction of t_max or earlier)")
     weights = values["lqi"]
+    schedule = values["schedule"]
+    points = schedule["points"]
+    if points != int(points) or points > 25:
+        raise PhysicalRangeError(f"schedule.points = {points:g}: must be a whole number from 1 to 25 (one design "
+                                 "per point)")
+    if schedule["field"] and values["feedforward"]["curve"] == "robust":
+        raise PhysicalRangeError(f"schedule.field = {schedule['field']!r} needs feedforward.curve = \"nominal\" (the "
+                                 "robust feedforward is one curve for every clutch); remove [schedule] or use the "
+                                 "nominal curve")
+    estimator = values["estimator"]
+    if not 0.0 < estimator["activation"] < 1.0:
+        raise PhysicalRangeError(f"estimator.activation = {estimator['activation']:g}: must be in (0, 1) (a fraction "
+                                 "of the nominal clutch torque's peak)")
+    if estimator["gain_limit"] <= 1.0:
+        raise PhysicalRangeError(f"estimator.gain_limit = {estimator['gain_limit']:g}: must be above 1 (the largest "
+                                 "ratio of nominal to estimated torque gain)")
+    if estimator["enabled"] and not c["measure_pressure"]:
+        raise PhysicalRangeError("estimator.enabled = true needs controller.measure_pressure = true (the torque gain "
+                                 "is the estimated clutch torque over the measured pressure)")
     return SlipControlSpec(sample_time=c["sample_time"], name=c["name"], description=c["description"],
                            pressure_min=c["pressure_min"], pressure_max=c["pressure_max"],
                            rate_limit_time=c["rate_limit_time"], measure_pressure=c["measure_pressure"],
                            progress=c["progress"], max_delay=c["max_delay"],
-                           lqi=weights, anti_windup=values["anti_windup"]["method"],
-                           feedforward_curve=values["feedforward"]["curve"], t_max_fraction=fraction)
+                           lqi=weights, anti_windup=values["anti_windup"]["method"], estimator=estimator,
+                           feedforward_curve=values["feedforward"]["curve"], t_max_fraction=fraction,
+                           schedule_field=schedule["field"], schedule_points=int(points))

@@ -1,0 +1,111 @@
+"""Slip feedback scheduled on a scene field the TCU measures: one design per value of a calibration grid.
+
+A transmission control unit reads its sump temperature, so it knows the oil viscosity to within its
+sensor and calibration, not the friction coefficient or the load. With ``[schedule] field =
+"oil.viscosity"`` and ``points = n`` the feedforward (the nominal optimum of the scene with that
+field set, solved with the spec's time margin) and the slip feedback designed along it are made at
+n values spread evenly over the field's uncertainty range; a clutch is driven by the design at the
+grid value nearest its own. Between grid values the clutch's field differs from its design's by up
+to half a grid step: the controller meets that residual as an unknown, like the friction and load.
+Without a schedule (or a field that is not uncertain) there is one design, on the nominal scene.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import MissingParameterError, ModelError
+from .design import design_slip_feedback
+
+
+@dataclass
+class FeedbackSchedule:
+    """Slip-feedback designs at grid values of one scene field (plain data: it is sent to worker processes).
+
+    Attributes
+    ----------
+    field : str
+        The scheduled scene field (``""``: no schedule, one design).
+    values : ndarray
+        Its grid values (SI); ``[nan]`` without a schedule.
+    feedbacks : list of SlipFeedback
+        The feedback designed at each grid value.
+    overrides : list of dict
+        The scene overrides each design was made on (``{}`` without a schedule).
+    lock_times : list of float
+        Lock-up time of each design's feedforward on its own scene [s].
+    """
+
+    field: str
+    values: np.ndarray
+    feedbacks: list
+    overrides: list
+    lock_times: list
+
+    def index(self, scene):
+        """Index of the design for a clutch: the grid value nearest the clutch's own value of the field."""
+        if not self.field:
+            return 0
+        return int(np.argmin(np.abs(self.values - scene.value(self.field))))
+
+    def select(self, scene):
+        """(SlipFeedback, overrides of the scene it was designed on) for a clutch ``scene``."""
+        i = self.index(scene)
+        return self.feedbacks[i], self.overrides[i]
+
+
+def schedule_values(scene, spec, uncertainty):
+    """Grid values (SI) of the spec's scheduled field over its spread in ``uncertainty`` (``[]``: no schedule).
+
+    Raises
+    ------
+    ModelError
+        The field is not a numeric scene field.
+    """
+    field = spec.schedule_field
+    if not field or spec.schedule_points == 1:
+        return []
+    try:
+        nominal = scene.value(field)
+    except MissingParameterError:
+        raise MissingParameterError(f"schedule.field = {field!r}: the scene '{scene.name}' has no such field") from None
+    if not isinstance(nominal, (int, float)) or isinstance(nominal, bool):
+        raise ModelError(f"schedule.field = {field!r}: must be a numeric scene field")
+    spread = next((s for s in uncertainty.spreads if s.key == field), None)
+    if spread is None or spread.kind == "values" and len(spread.values) == 1:
+        return []
+    low, high = spread.bounds
+    return list(np.linspace(low, high, spec.schedule_points))
+
+
+def design_schedule(scene, spec, uncertainty, feedforward_for, *, say=print):
+    """The feedback schedule of a spec on a scene (see the module docstring).
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+        The nominal scene.
+    spec : SlipControlSpec
+    uncertainty : clutchocp.uncertainty.Uncertainty
+    feedforward_for : callable
+        ``feedforward_for(design_scene) -> (times [s], command [Pa])``: the feedforward of a design scene.
+    say : callable
+        Progress messages.
+
+    Returns
+    -------
+    FeedbackSchedule
+    """
+    values = schedule_values(scene, spec, uncertainty)
+    overrides = [{spec.schedule_field: float(v)} for v in values] or [{}]
+    feedbacks, lock_times = [], []
+    for i, override in enumerate(overrides):
+        design_scene = scene.with_overrides(override) if override else scene
+        if override:
+            say(f"  design {i + 1}/{len(overrides)}: {spec.schedule_field} = {values[i]:.4g}")
+        times, command = feedforward_for(design_scene)
+        design = design_slip_feedback(design_scene, times, command, spec)
+        feedbacks.append(design.feedback)
+        lock_times.append(float(design.t_lock))
+    return FeedbackSchedule(spec.schedule_field if values else "", np.asarray(values, float) if values
+                            else np.array([np.nan]), feedbacks, overrides, lock_times)

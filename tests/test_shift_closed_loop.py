@@ -37,6 +37,9 @@ def test_closed_loop_on_the_nominal_clutch_reproduces_the_open_loop_optimum(desi
     assert b["dissipated_energy_J"] == pytest.approx(a["dissipated_energy_J"], rel=1e-3)
     # the feedback stays idle: corrections of a few pascals against a 1.5 MPa range
     assert np.max(np.abs(tcu["correction_Pa"])) < 100.0
+    # the spec's feedforward adaptation is on, and on the nominal clutch it estimates the nominal clutch
+    assert design.feedback.adaptation is not None
+    assert np.max(np.abs(tcu["scale"] - 1.0)) < 1e-4 and np.max(np.abs(tcu["shift_Pa"])) < 1.0
     assert tcu["handover_s"] is not None
 
 

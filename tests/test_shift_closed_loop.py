@@ -75,3 +75,37 @@ def test_limits_rate_limit_and_clamping_anti_windup():
     free = _toy_feedback(anti_windup="none")
     free.step(0, signals)
     assert free.integral == pytest.approx(0.01 * 10.0)
+
+
+def test_two_designs_blend_table_by_table():
+    """Blending two feedbacks (a TCU interpolating its calibration): every table and the feedforward are
+    the weighted mean of the two; weight 0 gives the first back; unlike designs do not blend."""
+    a = _toy_feedback(feedforward=([0.0, 0.1, 1.0], [2e5, 6e5, 6e5]))
+    b = _toy_feedback(gains=np.full((4, 3), [0.0, -3e6, 2e6]), integral_gains=np.full(4, -2e7),
+                      slip_reference=np.linspace(5.0, 0.0, 5), feedforward=([0.0, 0.05, 0.3, 1.0], [0.0, 8e5, 4e5, 4e5]))
+    mid = a.blended(b, 0.25)
+    assert mid.gains == pytest.approx(0.75 * a.gains + 0.25 * b.gains)
+    assert mid.integral_gains == pytest.approx(np.full(4, -1.25e7))
+    assert mid.slip_reference == pytest.approx(0.25 * b.slip_reference)
+    for t in np.linspace(0.0, 1.2, 37):         # piecewise linear on the union grid: exact everywhere
+        assert mid.feedforward(t) == pytest.approx(0.75 * a.feedforward(t) + 0.25 * b.feedforward(t))
+    same = a.blended(b, 0.0)
+    assert same.gains == pytest.approx(a.gains) and same.feedforward(0.07) == pytest.approx(a.feedforward(0.07))
+    assert a.blended(_toy_feedback(integral_gains=np.full(5, -1e7), gains=np.zeros((5, 3)),
+                                   reference=np.zeros((6, 3)), slip_reference=np.zeros(6)), 0.5) is None
+    assert a.blended(_toy_feedback(p_max=2e6), 0.5) is None
+
+
+def test_schedule_blends_between_grid_values_and_holds_outside():
+    from clutchocp.shiftcontrol.schedule import FeedbackSchedule
+
+    scene = default_scene().without_uncertainty()
+    eta = scene.value("oil.viscosity")
+    designs = [_toy_feedback(integral_gains=np.full(4, k)) for k in (-1e7, -2e7, -4e7)]
+    schedule = FeedbackSchedule("oil.viscosity", np.array([0.8, 1.0, 1.2]) * eta, designs,
+                                [{"oil.viscosity": f * eta} for f in (0.8, 1.0, 1.2)], [0.28] * 3)
+    at = lambda f: schedule.select(scene.with_overrides({"oil.viscosity": f * eta}))   # noqa: E731
+    assert at(1.0)[0] is designs[1] and at(0.7)[0] is designs[0] and at(1.3)[0] is designs[2]
+    feedback, overrides = at(1.15)
+    assert feedback.integral_gains == pytest.approx(np.full(4, -3.5e7))       # 3/4 of the way to the third
+    assert overrides == {"oil.viscosity": pytest.approx(1.15 * eta)}

@@ -121,7 +121,7 @@ def test_closed_loop_tracks_a_feedforward_with_a_time_margin_when_asked(monkeypa
 def test_closed_loop_is_scheduled_on_the_oil_viscosity(monkeypatch):
     """[schedule] field = "oil.viscosity", points = 3: one feedforward and feedback per viscosity at the
     ends and the centre of the scene's spread, each an optimum locking at t_max_fraction x t_max on its
-    own scene; a clutch gets the design of the nearest viscosity."""
+    own scene; a clutch between two viscosities gets their designs blended."""
     from dataclasses import replace
 
     from clutchocp.shiftcontrol import report
@@ -140,8 +140,11 @@ def test_closed_loop_is_scheduled_on_the_oil_viscosity(monkeypatch):
         assert t_lock == pytest.approx(spec.t_max_fraction * facts["t_max_s"], rel=0.01)
     assert schedule.index(nominal.with_overrides({"oil.viscosity": 0.8 * eta})) == 0
     assert schedule.index(nominal.with_overrides({"oil.viscosity": 1.1 * eta})) == 1
-    feedback, overrides = schedule.select(nominal.with_overrides({"oil.viscosity": 1.29 * eta}))
+    feedback, overrides = schedule.select(nominal.with_overrides({"oil.viscosity": 1.35 * eta}))
     assert feedback is schedule.feedbacks[2] and overrides == {"oil.viscosity": pytest.approx(1.3 * eta)}
+    # the three designs share their horizon (their optima lock within one TCU sample), so they blend
+    feedback, overrides = schedule.select(nominal.with_overrides({"oil.viscosity": 1.1 * eta}))
+    assert feedback.horizon == schedule.feedbacks[1].horizon and overrides == {"oil.viscosity": 1.1 * eta}
     # without the field in the uncertainty there is no grid: one design, on the nominal scene
     from clutchocp.shiftcontrol.schedule import schedule_values
     others = Uncertainty([s for s in Uncertainty.from_scene(scene).spreads if s.key != "oil.viscosity"])

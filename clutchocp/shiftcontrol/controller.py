@@ -94,6 +94,34 @@ class SlipFeedback:
         """Number of designed samples N (the nominal lock-up lies in the last one)."""
         return self.integral_gains.size
 
+    def blended(self, other, weight):
+        """The feedback whose tables are (1 - weight) x this one's + weight x ``other``'s, or None.
+
+        A TCU interpolates its calibration between two designs (e.g. made at two oil viscosities): gains,
+        references, the feedforward (on the union of both command grids, where both are linear) and the
+        adaptation's nominal estimates are blended. None when the two do not share their horizon,
+        measured signals and settings, or read their reference by slip progress.
+        """
+        same = (self.horizon == other.horizon and self.measured == other.measured and self.path is None
+                and other.path is None and (self.Ts, self.p_min, self.p_max, self.rate_limit, self.anti_windup)
+                == (other.Ts, other.p_min, other.p_max, other.rate_limit, other.anti_windup)
+                and (self.adaptation is None) == (other.adaptation is None))
+        if not same:
+            return None
+        w = float(weight)
+
+        def mix(a, b):
+            return (1.0 - w) * a + w * b
+
+        times = np.union1d(self.ff_times, other.ff_times)
+        adaptation = None if self.adaptation is None else self.adaptation.blended(other.adaptation, w)
+        return SlipFeedback(self.Ts, mix(self.gains, other.gains), mix(self.integral_gains, other.integral_gains),
+                            mix(self.reference, other.reference), mix(self.slip_reference, other.slip_reference),
+                            self.measured, (times, mix(np.interp(times, self.ff_times, self.ff_values),
+                                                       np.interp(times, other.ff_times, other.ff_values))),
+                            self.p_min, self.p_max, self.rate_limit, self.anti_windup, max_delay=self.max_delay,
+                            adaptation=adaptation)
+
     def reset(self):
         """Before a run: zero integral, no previous sample."""
         self.integral = 0.0

@@ -120,6 +120,15 @@ class FeedforwardAdaptation:
     gain_limit: float
     filter_time: float = 0.0
 
+    def blended(self, other, weight):
+        """The adaptation whose nominal estimates and activation are (1 - weight) x this one's + weight x ``other``'s."""
+        w = float(weight)
+        if self.nominal.shape != other.nominal.shape:
+            raise ModelError("feedforward adaptation: two designs with different horizons cannot be blended")
+        return FeedforwardAdaptation(self.estimator, (1 - w) * self.nominal + w * other.nominal,
+                                     (1 - w) * self.activation + w * other.activation, self.gain_limit,
+                                     self.filter_time)
+
     def correction(self, row, previous, current):
         """(scale, shift [Pa]) of the command at a sample, for the nominal ``row`` (T_c, T_L, p_mean) of its time."""
         clutch_nom, load_nom, p_nom = (float(v) for v in row)

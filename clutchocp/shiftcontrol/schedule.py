@@ -4,9 +4,10 @@ A transmission control unit reads its sump temperature, so it knows the oil visc
 sensor and calibration, not the friction coefficient or the load. With ``[schedule] field =
 "oil.viscosity"`` and ``points = n`` the feedforward (the nominal optimum of the scene with that
 field set, solved with the spec's time margin) and the slip feedback designed along it are made at
-n values spread evenly over the field's uncertainty range; a clutch is driven by the design at the
-grid value nearest its own. Between grid values the clutch's field differs from its design's by up
-to half a grid step: the controller meets that residual as an unknown, like the friction and load.
+n values spread evenly over the field's uncertainty range. A clutch between two grid values is driven
+by the two neighbouring designs blended linearly in the field (a TCU interpolating its calibration
+tables); the controller meets the rest of the clutch (friction, load, and the error of the
+interpolation) as an unknown.
 Without a schedule (or a field that is not uncertain) there is one design, on the nominal scene.
 """
 
@@ -43,15 +44,31 @@ class FeedbackSchedule:
     lock_times: list
 
     def index(self, scene):
-        """Index of the design for a clutch: the grid value nearest the clutch's own value of the field."""
+        """Index of the grid value nearest a clutch's own value of the field (0 without a schedule)."""
         if not self.field:
             return 0
         return int(np.argmin(np.abs(self.values - scene.value(self.field))))
 
     def select(self, scene):
-        """(SlipFeedback, overrides of the scene it was designed on) for a clutch ``scene``."""
-        i = self.index(scene)
-        return self.feedbacks[i], self.overrides[i]
+        """(SlipFeedback, overrides of the scene it stands for) for a clutch ``scene``.
+
+        The TCU interpolates its calibration: between two grid values the two designs are blended
+        linearly in the field (:meth:`SlipFeedback.blended`), outside the grid the end design is used,
+        and two designs that cannot be blended (different horizons) give the nearest one.
+        """
+        if not self.field:
+            return self.feedbacks[0], self.overrides[0]
+        value = scene.value(self.field)
+        upper = int(np.clip(np.searchsorted(self.values, value), 1, len(self.values) - 1))
+        weight = (value - self.values[upper - 1]) / (self.values[upper] - self.values[upper - 1])
+        if weight <= 0.0 or weight >= 1.0:
+            i = upper - 1 if weight <= 0.0 else upper
+            return self.feedbacks[i], self.overrides[i]
+        blended = self.feedbacks[upper - 1].blended(self.feedbacks[upper], weight)
+        if blended is None:
+            i = self.index(scene)
+            return self.feedbacks[i], self.overrides[i]
+        return blended, {self.field: float(value)}
 
 
 def schedule_values(scene, spec, uncertainty):

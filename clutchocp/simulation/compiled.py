@@ -59,10 +59,13 @@ class ColumnFunction:
 
     A CasADi ``map`` over the columns of ``xs, zs, t`` (``pu`` shared), called through the
     buffer interface: numpy arrays in and out, no DM conversions (which cost more than the
-    evaluation for a few thousand samples of a small function).
+    evaluation for a few thousand samples of a small function). ``loop``, for a function compiled
+    to machine code: its loop over samples (:func:`clutchocp.simulation.native.compile_columns`),
+    used instead of the map (the same compiled function on every sample, without CasADi's calling
+    machinery around each call).
     """
 
-    def __init__(self, function, max_maps=32):
+    def __init__(self, function, max_maps=32, loop=None):
         if not all(function.sparsity_in(i).is_dense() for i in range(4)) or not function.sparsity_out(0).is_dense():
             raise ModelError(f"{function.name()}: a column function needs dense inputs and output (densify them)")
         self.function = function
@@ -74,6 +77,7 @@ class ColumnFunction:
             function.instruction_id(k) == ca.OP_CALL for k in range(function.n_instructions()))
         self._numpy_built = False
         self._numpy_fn = None
+        self._loop = loop
 
     @property
     def _numpy(self):
@@ -99,6 +103,8 @@ class ColumnFunction:
         t = np.atleast_1d(np.asarray(t, float)).ravel()
         n = t.size
         nx, nz = self.sizes[:2]
+        if self._loop is not None and n:
+            return self._looped(xs, zs, pu, t, n)
         if n >= (MIN_SAMPLES if self._calls else vectorized.MIN_SAMPLES_PLAIN) and self._numpy is not None:
             out = np.empty((self.n_out, n))
             with np.errstate(all="ignore"):       # as CasADi: NaN/inf where the expression gives them
@@ -118,6 +124,18 @@ class ColumnFunction:
         buf.set_res(0, memoryview(out if out.size else dummy))
         evaluate()
         return out[:n].T
+
+    def _looped(self, xs, zs, pu, t, n):
+        """The compiled loop over the ``n`` samples (sample-major copies in, sample-major out)."""
+        nx, nz, npu = self.sizes[:3]
+        dummy = np.zeros(1)
+        args = [np.ascontiguousarray(np.reshape(np.asarray(xs, float), (nx, n)).T) if nx else dummy,
+                np.ascontiguousarray(np.reshape(np.asarray(zs, float), (nz, n)).T) if nz else dummy,
+                np.ascontiguousarray(np.ravel(np.asarray(pu, float))) if npu else dummy, np.ascontiguousarray(t)]
+        out = np.zeros((n, self.n_out)) if self.n_out else dummy
+        if self._loop(args, (nx, nz, 0, 1), [out], (self.n_out,), n):
+            raise RuntimeError(f"{self.function.name()}: the compiled evaluation failed")
+        return out.T if self.n_out else np.zeros((0, n))
 
 
 class CompiledMode:
@@ -255,17 +273,19 @@ class CompiledMode:
             calls = any(f.instruction_id(k) == ca.OP_CALL for k in range(f.n_instructions()))
             compiled = None
             if calls:
-                from clutchocp.simulation.native import compile_function
-                compiled = compile_function(f)
-            self._native_events_on = ColumnFunction(compiled) if compiled is not None else self.events_on
+                from clutchocp.simulation.native import compile_columns
+                compiled = compile_columns(f)
+            self._native_events_on = ColumnFunction(compiled[0], loop=compiled[1]) if compiled is not None \
+                else self.events_on
         return self._native_events_on
 
     def native_outputs_on(self):
         """:attr:`outputs_on` with the outputs compiled to machine code (itself if that fails)."""
         if self._native_outputs_on is None:
-            from clutchocp.simulation.native import compile_function
-            compiled = compile_function(self.f_outputs)
-            self._native_outputs_on = ColumnFunction(compiled) if compiled is not None else self.outputs_on
+            from clutchocp.simulation.native import compile_columns
+            compiled = compile_columns(self.f_outputs)
+            self._native_outputs_on = ColumnFunction(compiled[0], loop=compiled[1]) if compiled is not None \
+                else self.outputs_on
         return self._native_outputs_on
 
     # ----------------------------------------------------------------- algebraic variables

@@ -279,3 +279,36 @@ def test_outputs_and_events_through_the_compiled_loop_give_the_run_of_casadi_map
         if name != "mode":
             assert np.array_equal(a[name], b[name], equal_nan=True), name
     assert looped.summary["events"] == mapped.summary["events"]
+
+
+def test_events_and_outputs_evaluated_together_equal_the_separate_functions(driveline_runs, monkeypatch):
+    """Where a mode's events call tables (default_driveline, locked), the grid samples' events and
+    outputs come from one compiled function: its rows equal the compiled event function and the
+    compiled outputs bit for bit, and the run equals the run with separate evaluations."""
+    from clutchocp.engagement.model import EngagementModel
+    from clutchocp.engagement.run import simulate_engagement
+    from clutchocp.simulation.compiled import CompiledMode
+    from clutchocp.simulation.native import compiler
+
+    if compiler() is None:
+        pytest.skip("no C compiler")
+    model, runs = driveline_runs
+    compiled = model.hybrid.compiled()
+    locked = compiled["pressing_locked"]
+    merged = locked.native_events_outputs()
+    assert merged is not None and compiled["pressing_slip_forward"].native_events_outputs() is None   # no table call
+    seg = next(s for s in runs["native"].result.segments if s.mode == "pressing_locked")
+    xs = np.array([seg.x[k] / nominal for k, nominal in zip(locked.x_names, locked.x_nominal)])
+    zs = np.zeros((0, seg.t.size))
+    pu = np.random.default_rng(2).uniform(0.5, 1.5, locked.pu.numel())
+    both = merged(xs, zs, pu, seg.t)
+    n_events = len(locked.events)
+    assert np.array_equal(both[:n_events], locked.event_values(True)(xs, zs, pu, seg.t), equal_nan=True)
+    assert np.array_equal(both[n_events:], locked.native_outputs_on()(xs, zs, pu, seg.t), equal_nan=True)
+    monkeypatch.setattr(CompiledMode, "native_events_outputs", lambda self: None)
+    separate = simulate_engagement(model.scene, model=EngagementModel(model.scene), native=True)
+    a, b = runs["native"].series(), separate.series()
+    for name in a:
+        if name != "mode":
+            assert np.array_equal(a[name], b[name], equal_nan=True), name
+    assert runs["native"].summary["events"] == separate.summary["events"]

@@ -312,3 +312,29 @@ def test_events_and_outputs_evaluated_together_equal_the_separate_functions(driv
         if name != "mode":
             assert np.array_equal(a[name], b[name], equal_nan=True), name
     assert runs["native"].summary["events"] == separate.summary["events"]
+
+
+def test_one_sample_calls_through_bound_buffers_equal_casadi_calls():
+    """One sample goes through arrays bound to the 1-sample map once: every call gives CasADi's own
+    value for its sample (values refreshed, outputs that are constant zeros still zero, an empty
+    input), also after the 1-sample map was evicted and built again, and the result is a copy."""
+    import casadi as ca
+
+    from clutchocp.simulation.compiled import ColumnFunction
+
+    xs, zs, pu, t = ca.SX.sym("xs", 2), ca.SX.sym("zs", 0), ca.SX.sym("pu", 3), ca.SX.sym("t")
+    f = ca.Function("one", [xs, zs, pu, t], [ca.densify(ca.vertcat(ca.exp(xs[0]) * pu[2] - t, ca.SX(0), xs[1] / pu[0]))])
+    column = ColumnFunction(f, max_maps=2)
+    rng = np.random.default_rng(23)
+    kept = []
+    for k in range(6):
+        x, p, time_ = rng.normal(size=2), rng.uniform(0.5, 2.0, 3), float(rng.uniform())
+        got = column(x, np.zeros(0), p, time_)
+        assert got.shape == (3, 1)
+        assert np.array_equal(got[:, 0], np.array(f(x, np.zeros(0), p, time_)).ravel())
+        kept.append((got, np.array(f(x, np.zeros(0), p, time_)).ravel()))
+        if k == 2:                                  # evict the 1-sample map: two other sizes
+            column(np.zeros((2, 3)), np.zeros((0, 3)), p, np.zeros(3))
+            column(np.zeros((2, 5)), np.zeros((0, 5)), p, np.zeros(5))
+            assert 1 not in column._maps
+    assert all(np.array_equal(got[:, 0], reference) for got, reference in kept)   # earlier results untouched

@@ -78,6 +78,7 @@ class ColumnFunction:
         self._numpy_built = False
         self._numpy_fn = None
         self._loop = loop
+        self._one = None            # (map entry, input arrays, output array) bound to the 1-sample map's buffer
 
     @property
     def _numpy(self):
@@ -113,6 +114,8 @@ class ColumnFunction:
             return out
         if n == 0:
             return np.zeros((self.n_out, 0))
+        if n == 1:
+            return self._single(xs, zs, pu, t)
         m = padded_size(n)                         # a few cached maps serve every sample count
         _, buf, evaluate = self._map(m)
         args = [_padded(xs, nx, n, m), _padded(zs, nz, n, m), np.ascontiguousarray(np.ravel(np.asarray(pu, float))),
@@ -124,6 +127,26 @@ class ColumnFunction:
         buf.set_res(0, memoryview(out if out.size else dummy))
         evaluate()
         return out[:n].T
+
+    def _single(self, xs, zs, pu, t):
+        """One sample on the 1-sample map, through arrays bound to its buffer once (a run makes
+        ~20 such calls: guards, resets, event values and slopes at one time, outputs at events)."""
+        entry = self._map(1)
+        if self._one is None or self._one[0] is not entry:
+            _, buf, _ = entry
+            args = [np.zeros(max(size, 1)) for size in self.sizes]     # an empty input gets a dummy
+            out = np.zeros(max(self.n_out, 1))
+            for i, a in enumerate(args):
+                buf.set_arg(i, memoryview(a))
+            buf.set_res(0, memoryview(out))
+            self._one = (entry, args, out)
+        entry, args, out = self._one
+        for a, v, size in zip(args, (xs, zs, pu, t), self.sizes):
+            if size:
+                a[:] = np.ravel(v)
+        out[:] = 0.0                              # CasADi leaves outputs that are constant zeros unwritten
+        entry[2]()
+        return out[:self.n_out].reshape(self.n_out, 1).copy()
 
     def _looped(self, xs, zs, pu, t, n):
         """The compiled loop over the ``n`` samples (sample-major copies in, sample-major out)."""

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from clutchocp.errors import ModelError
+from clutchocp.errors import ModelError, SolverError
 from clutchocp.simulation.model import time_derivative
 from clutchocp.simulation import vectorized
 from clutchocp.simulation.vectorized import MIN_SAMPLES, numpy_function, padded_size
@@ -157,7 +157,8 @@ class ColumnFunction:
                 np.ascontiguousarray(np.ravel(np.asarray(pu, float))) if npu else dummy, np.ascontiguousarray(t)]
         out = np.zeros((n, self.n_out)) if self.n_out else dummy
         if self._loop(args, (nx, nz, 0, 1), [out], (self.n_out,), n):
-            raise RuntimeError(f"{self.function.name()}: the compiled evaluation failed")
+            raise SolverError(f"the compiled function {self.function.name()} failed on {n} samples "
+                              f"(t = {t[0]:.6g} ... {t[-1]:.6g} s); try: run without native code")
         return out.T if self.n_out else np.zeros((0, n))
 
 

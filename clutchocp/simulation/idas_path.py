@@ -29,7 +29,10 @@ a restart at the first grid point 2000). With ``chunk`` given, calls cover ``chu
 intervals, growing by ``chunk_growth``. Mode integrations use ``native_dae`` instead of
 ``dae_tau`` when ``native=True`` (see :mod:`clutchocp.simulation.native`).
 
-The scaled event functions are evaluated on the outputs; at the first sign change the
+The scaled event functions are evaluated on the outputs (with ``native=True``, in a mode whose
+event functions call tables, together with the mode's outputs in one compiled function:
+:meth:`~clutchocp.simulation.compiled.CompiledMode.native_events_outputs`; the outputs of the
+grid samples kept go back to the driver in ``Advance.y``); at the first sign change the
 crossing is located by short IDAS integrations started from the latest point known to lie
 before it: a cubic Hermite interpolant of the grid values gives the first trial time, then
 safeguarded secant steps (:func:`~clutchocp.simulation.events.locate`) until the bracket is

@@ -12,7 +12,9 @@ C). Its share is ``1 - integration_time_s / run_time_s`` of its row (the definit
 (the first builds the model and integrators that later points reuse). Also reported: points per
 second on one core (the inverse of the mean point time), and where a point's time goes (a second
 pass over points between those, with timers around the parts: scene with the overrides,
-integrator look-up and construction, event location, outputs on the grid, summary).
+integrator look-up and construction, event location, event functions on samples, outputs on the
+grid, where the tree has it the grid's events evaluated with its outputs in one compiled call, and
+the summary; the parts overlap: event location includes its event functions and integrator calls).
 ``cpu_share`` is the same share in CPU time of the process's thread (``time.thread_time``, around
 each point and around each ``IdasPath._run``), ``cpu_point_ms`` a point's CPU time: on a machine
 shared with other jobs the wall times move with their load, the CPU times much less, and
@@ -61,8 +63,27 @@ def _timers(acc):
     wrap(tasks, "point_scene", "scene with overrides")
     wrap(idas_path.IdasPath, "_integrator", "integrator look-up and construction")
     wrap(idas_path.IdasPath, "_locate", "event location (integrator calls included)")
+    wrap(idas_path.IdasPath, "_events", "event functions on samples")
     wrap(driver._Run, "segments", "outputs on the grid")
     wrap(run, "summarize", "summary")
+    from clutchocp.simulation.compiled import CompiledMode as compiled
+    if hasattr(compiled, "native_events_outputs"):      # trees that evaluate a grid's events with its outputs
+        inner_merged = compiled.native_events_outputs
+
+        def merged(self):
+            function = inner_merged(self)
+            if function is None:
+                return None
+
+            def timed(*args):
+                start = time.perf_counter()
+                try:
+                    return function(*args)
+                finally:
+                    label = "events with outputs on the grid (one compiled call)"
+                    acc[label] = acc.get(label, 0.0) + time.perf_counter() - start
+            return timed
+        compiled.native_events_outputs = merged
 
 
 def worker(scene, native, points, warm_up):

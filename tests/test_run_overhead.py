@@ -220,3 +220,121 @@ def test_single_sample_functions_equal_the_casadi_calls(driveline_runs):
     for what, function in pairs:
         reference = np.array(ca.densify(function(xs, zs, pu, t))).ravel()
         assert np.array_equal(cm.at(what, xs, zs, pu, t), reference), what
+
+
+def test_compiled_loop_over_samples_equals_casadi_calls_sample_by_sample():
+    """The compiled loop evaluates the generated function itself on each sample: bit for bit what
+    CasADi's call of the same compiled function gives, with a table call, an empty input, a
+    parameter vector shared by all samples and outputs that are constant zeros."""
+    import casadi as ca
+
+    from clutchocp.physics.roughness import log_F52
+    from clutchocp.simulation.compiled import ColumnFunction
+    from clutchocp.simulation.native import compile_columns, compiler
+
+    if compiler() is None:
+        pytest.skip("no C compiler")
+    xs, zs, pu, t = ca.SX.sym("xs", 3), ca.SX.sym("zs", 0), ca.SX.sym("pu", 2), ca.SX.sym("t")
+    f = ca.Function("loop_probe", [xs, zs, pu, t],
+                    [ca.densify(ca.vertcat(log_F52(1 + xs[0] ** 2) * pu[1], ca.exp(-xs[1] * t) / (1 + xs[2] ** 2),
+                                           ca.SX(0), pu[0] * t))])
+    external, loop = compile_columns(f)
+    column = ColumnFunction(external, loop=loop)
+    rng = np.random.default_rng(17)
+    p = np.array([0.4, -2.5])
+    for n in (1, 2, 7, 300):
+        X, T = rng.uniform(0, 3, (3, n)), rng.uniform(0, 1, n)
+        reference = np.column_stack([np.array(external(X[:, k], np.zeros(0), p, T[k])).ravel() for k in range(n)])
+        got = column(X, np.zeros((0, n)), p, T)
+        assert got.shape == (4, n) and np.array_equal(got, reference)
+        vm = np.column_stack([np.array(f(X[:, k], np.zeros(0), p, T[k])).ravel() for k in range(n)])
+        assert np.allclose(got, vm, rtol=1e-13, atol=0)        # CasADi's virtual machine, to rounding
+    assert not column._maps                                    # no CasADi map was built
+    assert column(np.zeros((3, 0)), np.zeros((0, 0)), p, np.zeros(0)).shape == (4, 0)
+
+
+def test_outputs_and_events_through_the_compiled_loop_give_the_run_of_casadi_maps(driveline_runs, monkeypatch):
+    """default_driveline as compiled code, once through the compiled loops and once through
+    CasADi maps of the same compiled functions: every column and event time bit for bit equal."""
+    from clutchocp.engagement.model import EngagementModel
+    from clutchocp.engagement.run import simulate_engagement
+    from clutchocp.simulation import compiled
+    from clutchocp.simulation.native import compiler
+
+    if compiler() is None:
+        pytest.skip("no C compiler")
+    model, runs = driveline_runs
+    looped = runs["native"]
+    cm = model.hybrid.compiled()["pressing_locked"]
+    assert cm.native_outputs_on()._loop is not None and cm.event_values(True)._loop is not None
+    init = compiled.ColumnFunction.__init__
+    monkeypatch.setattr(compiled.ColumnFunction, "__init__",
+                        lambda self, function, max_maps=32, loop=None: init(self, function, max_maps))
+    fresh = EngagementModel(model.scene)
+    mapped = simulate_engagement(model.scene, model=fresh, native=True)
+    assert fresh.hybrid.compiled()["pressing_locked"].native_outputs_on()._loop is None
+    a, b = looped.series(), mapped.series()
+    assert list(a) == list(b)
+    for name in a:
+        if name != "mode":
+            assert np.array_equal(a[name], b[name], equal_nan=True), name
+    assert looped.summary["events"] == mapped.summary["events"]
+
+
+def test_events_and_outputs_evaluated_together_equal_the_separate_functions(driveline_runs, monkeypatch):
+    """Where a mode's events call tables (default_driveline, locked), the grid samples' events and
+    outputs come from one compiled function: its rows equal the compiled event function and the
+    compiled outputs bit for bit, and the run equals the run with separate evaluations."""
+    from clutchocp.engagement.model import EngagementModel
+    from clutchocp.engagement.run import simulate_engagement
+    from clutchocp.simulation.compiled import CompiledMode
+    from clutchocp.simulation.native import compiler
+
+    if compiler() is None:
+        pytest.skip("no C compiler")
+    model, runs = driveline_runs
+    compiled = model.hybrid.compiled()
+    locked = compiled["pressing_locked"]
+    merged = locked.native_events_outputs()
+    assert merged is not None and compiled["pressing_slip_forward"].native_events_outputs() is None   # no table call
+    seg = next(s for s in runs["native"].result.segments if s.mode == "pressing_locked")
+    xs = np.array([seg.x[k] / nominal for k, nominal in zip(locked.x_names, locked.x_nominal)])
+    zs = np.zeros((0, seg.t.size))
+    pu = np.random.default_rng(2).uniform(0.5, 1.5, locked.pu.numel())
+    both = merged(xs, zs, pu, seg.t)
+    n_events = len(locked.events)
+    assert np.array_equal(both[:n_events], locked.event_values(True)(xs, zs, pu, seg.t), equal_nan=True)
+    assert np.array_equal(both[n_events:], locked.native_outputs_on()(xs, zs, pu, seg.t), equal_nan=True)
+    monkeypatch.setattr(CompiledMode, "native_events_outputs", lambda self: None)
+    separate = simulate_engagement(model.scene, model=EngagementModel(model.scene), native=True)
+    a, b = runs["native"].series(), separate.series()
+    for name in a:
+        if name != "mode":
+            assert np.array_equal(a[name], b[name], equal_nan=True), name
+    assert runs["native"].summary["events"] == separate.summary["events"]
+
+
+def test_one_sample_calls_through_bound_buffers_equal_casadi_calls():
+    """One sample goes through arrays bound to the 1-sample map once: every call gives CasADi's own
+    value for its sample (values refreshed, outputs that are constant zeros still zero, an empty
+    input), also after the 1-sample map was evicted and built again, and the result is a copy."""
+    import casadi as ca
+
+    from clutchocp.simulation.compiled import ColumnFunction
+
+    xs, zs, pu, t = ca.SX.sym("xs", 2), ca.SX.sym("zs", 0), ca.SX.sym("pu", 3), ca.SX.sym("t")
+    f = ca.Function("one", [xs, zs, pu, t], [ca.densify(ca.vertcat(ca.exp(xs[0]) * pu[2] - t, ca.SX(0), xs[1] / pu[0]))])
+    column = ColumnFunction(f, max_maps=2)
+    rng = np.random.default_rng(23)
+    kept = []
+    for k in range(6):
+        x, p, time_ = rng.normal(size=2), rng.uniform(0.5, 2.0, 3), float(rng.uniform())
+        got = column(x, np.zeros(0), p, time_)
+        assert got.shape == (3, 1)
+        assert np.array_equal(got[:, 0], np.array(f(x, np.zeros(0), p, time_)).ravel())
+        kept.append((got, np.array(f(x, np.zeros(0), p, time_)).ravel()))
+        if k == 2:                                  # evict the 1-sample map: two other sizes
+            column(np.zeros((2, 3)), np.zeros((0, 3)), p, np.zeros(3))
+            column(np.zeros((2, 5)), np.zeros((0, 5)), p, np.zeros(5))
+            assert 1 not in column._maps
+    assert all(np.array_equal(got[:, 0], reference) for got, reference in kept)   # earlier results untouched

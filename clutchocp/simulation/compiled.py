@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from clutchocp.errors import ModelError
+from clutchocp.errors import ModelError, SolverError
 from clutchocp.simulation.model import time_derivative
 from clutchocp.simulation import vectorized
 from clutchocp.simulation.vectorized import MIN_SAMPLES, numpy_function, padded_size
@@ -59,10 +59,13 @@ class ColumnFunction:
 
     A CasADi ``map`` over the columns of ``xs, zs, t`` (``pu`` shared), called through the
     buffer interface: numpy arrays in and out, no DM conversions (which cost more than the
-    evaluation for a few thousand samples of a small function).
+    evaluation for a few thousand samples of a small function). ``loop``, for a function compiled
+    to machine code: its loop over samples (:func:`clutchocp.simulation.native.compile_columns`),
+    used instead of the map (the same compiled function on every sample, without CasADi's calling
+    machinery around each call).
     """
 
-    def __init__(self, function, max_maps=32):
+    def __init__(self, function, max_maps=32, loop=None):
         if not all(function.sparsity_in(i).is_dense() for i in range(4)) or not function.sparsity_out(0).is_dense():
             raise ModelError(f"{function.name()}: a column function needs dense inputs and output (densify them)")
         self.function = function
@@ -74,6 +77,8 @@ class ColumnFunction:
             function.instruction_id(k) == ca.OP_CALL for k in range(function.n_instructions()))
         self._numpy_built = False
         self._numpy_fn = None
+        self._loop = loop
+        self._one = None            # (map entry, input arrays, output array) bound to the 1-sample map's buffer
 
     @property
     def _numpy(self):
@@ -99,6 +104,8 @@ class ColumnFunction:
         t = np.atleast_1d(np.asarray(t, float)).ravel()
         n = t.size
         nx, nz = self.sizes[:2]
+        if self._loop is not None and n:
+            return self._looped(xs, zs, pu, t, n)
         if n >= (MIN_SAMPLES if self._calls else vectorized.MIN_SAMPLES_PLAIN) and self._numpy is not None:
             out = np.empty((self.n_out, n))
             with np.errstate(all="ignore"):       # as CasADi: NaN/inf where the expression gives them
@@ -107,6 +114,8 @@ class ColumnFunction:
             return out
         if n == 0:
             return np.zeros((self.n_out, 0))
+        if n == 1:
+            return self._single(xs, zs, pu, t)
         m = padded_size(n)                         # a few cached maps serve every sample count
         _, buf, evaluate = self._map(m)
         args = [_padded(xs, nx, n, m), _padded(zs, nz, n, m), np.ascontiguousarray(np.ravel(np.asarray(pu, float))),
@@ -118,6 +127,39 @@ class ColumnFunction:
         buf.set_res(0, memoryview(out if out.size else dummy))
         evaluate()
         return out[:n].T
+
+    def _single(self, xs, zs, pu, t):
+        """One sample on the 1-sample map, through arrays bound to its buffer once (a run makes
+        ~20 such calls: guards, resets, event values and slopes at one time, outputs at events)."""
+        entry = self._map(1)
+        if self._one is None or self._one[0] is not entry:
+            _, buf, _ = entry
+            args = [np.zeros(max(size, 1)) for size in self.sizes]     # an empty input gets a dummy
+            out = np.zeros(max(self.n_out, 1))
+            for i, a in enumerate(args):
+                buf.set_arg(i, memoryview(a))
+            buf.set_res(0, memoryview(out))
+            self._one = (entry, args, out)
+        entry, args, out = self._one
+        for a, v, size in zip(args, (xs, zs, pu, t), self.sizes):
+            if size:
+                a[:] = np.ravel(v)
+        out[:] = 0.0                              # CasADi leaves outputs that are constant zeros unwritten
+        entry[2]()
+        return out[:self.n_out].reshape(self.n_out, 1).copy()
+
+    def _looped(self, xs, zs, pu, t, n):
+        """The compiled loop over the ``n`` samples (sample-major copies in, sample-major out)."""
+        nx, nz, npu = self.sizes[:3]
+        dummy = np.zeros(1)
+        args = [np.ascontiguousarray(np.reshape(np.asarray(xs, float), (nx, n)).T) if nx else dummy,
+                np.ascontiguousarray(np.reshape(np.asarray(zs, float), (nz, n)).T) if nz else dummy,
+                np.ascontiguousarray(np.ravel(np.asarray(pu, float))) if npu else dummy, np.ascontiguousarray(t)]
+        out = np.zeros((n, self.n_out)) if self.n_out else dummy
+        if self._loop(args, (nx, nz, 0, 1), [out], (self.n_out,), n):
+            raise SolverError(f"the compiled function {self.function.name()} failed on {n} samples "
+                              f"(t = {t[0]:.6g} ... {t[-1]:.6g} s); try: run without native code")
+        return out.T if self.n_out else np.zeros((0, n))
 
 
 class CompiledMode:
@@ -183,6 +225,7 @@ class CompiledMode:
         self._native_dae = None
         self._native_outputs_on = None
         self._native_events_on = None
+        self._native_events_outputs = None
         self._on_samples = {}
         self.integrators = {}       # cached casadi integrators of this mode (see idas_path)
 
@@ -255,17 +298,43 @@ class CompiledMode:
             calls = any(f.instruction_id(k) == ca.OP_CALL for k in range(f.n_instructions()))
             compiled = None
             if calls:
-                from clutchocp.simulation.native import compile_function
-                compiled = compile_function(f)
-            self._native_events_on = ColumnFunction(compiled) if compiled is not None else self.events_on
+                from clutchocp.simulation.native import compile_columns
+                compiled = compile_columns(f)
+            self._native_events_on = ColumnFunction(compiled[0], loop=compiled[1]) if compiled is not None \
+                else self.events_on
         return self._native_events_on
+
+    def native_events_outputs(self):
+        """Column function of the scaled event functions followed by the outputs, compiled to machine
+        code as one function (shared subexpressions evaluated once), or None.
+
+        Only for a mode whose event functions call tables, where :meth:`event_values` and
+        :meth:`native_outputs_on` are both compiled: the compiled code performs the same operations
+        on the same numbers as the two separate functions, so each value is bit for bit theirs
+        (tested). Elsewhere the events are evaluated by numpy or CasADi and a merged compiled
+        function would change them by rounding. A locked mode's events (static capacity against
+        the torque to hold) repeat much of its outputs: bao2020, 159 and 373 instructions, 377
+        together.
+        """
+        if self._native_events_outputs is None:
+            merged = None
+            if self.events and self.event_values(True) is not self.events_on:
+                from clutchocp.simulation.native import compile_columns
+                args = [self.xs, self.zs, self.pu, self.t]
+                both = ca.Function(f"{self.name}_events_outputs", args,
+                                   [ca.densify(ca.cse(ca.vertcat(self.f_events(*args), self.f_outputs(*args))))])
+                compiled = compile_columns(both)
+                merged = ColumnFunction(compiled[0], loop=compiled[1]) if compiled is not None else None
+            self._native_events_outputs = merged or False
+        return self._native_events_outputs or None
 
     def native_outputs_on(self):
         """:attr:`outputs_on` with the outputs compiled to machine code (itself if that fails)."""
         if self._native_outputs_on is None:
-            from clutchocp.simulation.native import compile_function
-            compiled = compile_function(self.f_outputs)
-            self._native_outputs_on = ColumnFunction(compiled) if compiled is not None else self.outputs_on
+            from clutchocp.simulation.native import compile_columns
+            compiled = compile_columns(self.f_outputs)
+            self._native_outputs_on = ColumnFunction(compiled[0], loop=compiled[1]) if compiled is not None \
+                else self.outputs_on
         return self._native_outputs_on
 
     # ----------------------------------------------------------------- algebraic variables

@@ -46,6 +46,7 @@ class Advance:
     xs: np.ndarray      # (nx, n)
     zs: np.ndarray      # (nz, n)
     crossing: Crossing | None = None
+    y: np.ndarray | None = None     # (n_outputs, n): the mode's outputs on the samples, if already evaluated
 
 
 class EventMonitor:

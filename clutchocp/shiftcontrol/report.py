@@ -126,7 +126,8 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         say(f"  nominal optimum for the closed loop at {spec.t_max_fraction:g} x t_max = "
             f"{spec.t_max_fraction * t_max:.4g} s")
         feedforward = ("nominal_optimum_with_margin",) + feedforward[1:]
-    ff_label = feedforward[0].replace("_", " ") + (f" ({spec.t_max_fraction:g} x t_max)" if margin else "")
+    ff_label = ("nominal optimum" if margin else feedforward[0].replace("_", " ")) \
+        + (f" at {spec.t_max_fraction:g} t_max" if margin else "")
 
     def feedforward_for(design_scene):
         # the closed loop's feedforward on a design scene: the curve chosen above on the nominal scene,
@@ -143,7 +144,10 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
     say(f"  slip feedback on the {ff_label}: {spec.label}, Ts = {spec.sample_time * 1e3:g} ms"
         + (f", scheduled on {spec.schedule_field} ({spec.schedule_points} points)" if spec.schedule_field else ""))
     schedule = design_schedule(scene, spec, uncertainty, feedforward_for, say=say)
-    strategies.append(Strategy("closed_loop", f"slip feedback on {ff_label}",
+    traits = [t for t, on in (("adaptive", spec.estimator["enabled"]),
+                               (f"{len(schedule.feedbacks)} designs over {schedule.field}", bool(schedule.field))) if on]
+    strategies.append(Strategy("closed_loop", f"slip feedback on {ff_label}"
+                               + (f" ({', '.join(traits)})" if traits else ""),
                                feedback=schedule, notes={"feedforward": feedforward[0]}))
     facts["closed_loop"] = {"feedforward": feedforward[0], "feedforward_t_max_fraction": spec.t_max_fraction,
                             "controller": spec.label, "sample_time_s": spec.sample_time,
@@ -395,7 +399,7 @@ def plot_envelopes(out, rows, centre, strategies, t_max):
             ax.axvline(t_max, color="k", lw=0.6, ls="--")
             ax.grid(alpha=0.3)
             if i == 0:
-                ax.set_title(s.label, fontsize=8)
+                ax.set_title(textwrap.fill(s.label, 48), fontsize=8)
             if j == 0:
                 ax.set_ylabel(label)
             if i == len(signals) - 1:

@@ -184,11 +184,9 @@ class SlipFeedback:
         rate = (w_rel - self._previous_slip) / self.Ts if self._previous_slip is not None else None
         if self.adaptation is not None and self.enabled:
             row = self._at(self.adaptation.nominal, tau)
-            scale, shift = self.adaptation.correction(row, self._previous_signals, signals)
-            if scale != 1.0 or shift != 0.0 or self.scale == 1.0:
-                blend = self.Ts / (self.Ts + self.adaptation.filter_time)
-                self.scale += blend * (scale - self.scale)
-                self.shift_Pa += blend * (shift - self.shift_Pa)
+            estimate = self.adaptation.correction(row, self._previous_signals, signals)
+            if estimate != (1.0, 0.0):      # outside the adapted stretch the last estimate is held
+                self.scale, self.shift_Pa = estimate
         y = []
         for j, name in enumerate(self.measured):
             if name == "slip_rate":

@@ -221,5 +221,4 @@ def _adaptation(scene, spec, sample_times, state_at, state_names):
         raise ModelError("estimator.enabled = true: the nominal engagement locks within one TCU sample; nothing to adapt")
     table = np.vstack([rows[:1], rows, rows[-1:]])
     activation = spec.estimator["activation"] * float(np.max(rows[:, 0]))
-    return FeedforwardAdaptation(estimator, table, activation, spec.estimator["gain_limit"],
-                                 spec.estimator["filter_time"])
+    return FeedforwardAdaptation(estimator, table, activation, spec.estimator["gain_limit"])

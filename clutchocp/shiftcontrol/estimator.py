@@ -98,9 +98,10 @@ class FeedforwardAdaptation:
     with du the LQI correction, scaled with the feedforward so that its loop gain stays the designed
     one. g_nom and T_L,nom are the same estimates taken on the nominal trajectory at the same samples,
     so on the nominal clutch scale = 1 and shift = 0 exactly (the feedback stays idle). The
-    adaptation starts once the nominal clutch torque of the sample reaches ``activation`` [N m]
-    (before, the films carry the pressure and the torque is not proportional to it), and the
-    ratio is kept within [1/gain_limit, gain_limit].
+    adaptation acts while the nominal clutch torque of the sample is at least ``activation`` [N m]:
+    before, the films carry the pressure and the torque is not proportional to it; after, on the
+    approach to lock-up, the TCU holds its last estimate (:meth:`correction` returns (1, 0) outside
+    that stretch). The ratio is kept within [1/gain_limit, gain_limit].
 
     Parameters
     ----------
@@ -118,7 +119,6 @@ class FeedforwardAdaptation:
     nominal: np.ndarray
     activation: float
     gain_limit: float
-    filter_time: float = 0.0
 
     def blended(self, other, weight):
         """The adaptation whose nominal estimates and activation are (1 - weight) x this one's + weight x ``other``'s."""
@@ -126,8 +126,7 @@ class FeedforwardAdaptation:
         if self.nominal.shape != other.nominal.shape:
             raise ModelError("feedforward adaptation: two designs with different horizons cannot be blended")
         return FeedforwardAdaptation(self.estimator, (1 - w) * self.nominal + w * other.nominal,
-                                     (1 - w) * self.activation + w * other.activation, self.gain_limit,
-                                     self.filter_time)
+                                     (1 - w) * self.activation + w * other.activation, self.gain_limit)
 
     def correction(self, row, previous, current):
         """(scale, shift [Pa]) of the command at a sample, for the nominal ``row`` (T_c, T_L, p_mean) of its time."""

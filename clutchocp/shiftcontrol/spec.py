@@ -25,7 +25,7 @@ field::
 
     [estimator]                      # the command rescaled to the clutch met (torque gain and load from the speeds)
     enabled = true
-    activation = 0.3                 # from when the nominal clutch torque reaches this fraction of its peak
+    activation = 0.5                 # adapt while the nominal clutch torque is above this fraction of its peak
     gain_limit = 1.5                 # largest ratio of nominal to estimated torque gain (and its inverse)
 
     [feedforward]
@@ -70,7 +70,7 @@ _LQI = {
 }
 _ANTI_WINDUP = {"method": ("choice", ANTI_WINDUP, "clamping")}
 _ESTIMATOR = {"enabled": ("bool", None, False), "activation": ("1", "positive", 0.3),
-              "gain_limit": ("1", "positive", 1.5), "filter_time": ("s", "nonnegative", 0.0)}
+              "gain_limit": ("1", "positive", 1.5)}
 _FEEDFORWARD = {"curve": ("choice", CURVES, "nominal"), "t_max_fraction": ("1", "positive", 1.0)}
 _SCHEDULE = {"field": ("str", None, ""), "points": ("1", "positive", 1.0)}
 _TABLES = {"controller": _CONTROLLER, "lqi": _LQI, "anti_windup": _ANTI_WINDUP, "estimator": _ESTIMATOR,

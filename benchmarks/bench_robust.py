@@ -22,9 +22,13 @@ samples per second (both strategies per sample).
 Defaults are the settings of ``clutchocp robust`` (``ROBUST_*`` in clutchocp/shiftcontrol/report.py).
 Run from the repository root:
 
-    python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 10] [--jump-weight 100]
-        [--aggregate mean|worst] [--t-max-margin 0.05] [--montecarlo 200 --seed 0 --workers 2]
-        [--acceptance SCENARIOS] [--out DIR] [--json FILE]
+    python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 10] [--presolve 10] [--jump-weight 100]
+        [--jerk-weight 1] [--smooth-weight 0.1] [--aggregate mean|worst|worst_jump] [--diagonal]
+        [--t-max-margin 0.05] [--montecarlo 200 --seed 0 --workers 2] [--acceptance SCENARIOS] [--out DIR]
+        [--json FILE]
+
+The worst-jump feedforward of the README: ``--scenarios 9 --diagonal --aggregate worst_jump --jump-weight 1000
+--jerk-weight 0.1 --smooth-weight 0.01 --t-max-margin 0.02`` (``--diagonal`` adds the two lock_diagonal points).
 """
 
 import argparse
@@ -38,7 +42,7 @@ import numpy as np
 from clutchocp.engagement.run import simulate_engagement
 from clutchocp.errors import ClutchocpError
 from clutchocp.optimal import EngagementOCP
-from clutchocp.optimal.robust import RobustOCP
+from clutchocp.optimal.robust import AGGREGATES, PRESOLVE_INTERVALS, RobustOCP, lock_diagonal
 from clutchocp.optimal.replay import CommandModel, simulate_command
 from clutchocp.output import new_figure, save_figure
 from clutchocp.scene import default_scene
@@ -52,23 +56,24 @@ def box_points(scene):
     return box.corners(), box.centre()
 
 
-def scenario_set(scene, count):
+def scenario_set(scene, count, diagonal=False):
+    """The box points of a set (1, 3, 5, 9), with ``diagonal`` the lock_diagonal points of the box added."""
     corners, centre = box_points(scene)
     sets = {1: [centre], 3: [corners[0], centre, corners[-1]],
             5: [centre, corners[0], corners[3], corners[5], corners[6]], 9: corners + [centre]}
     if count not in sets:
         sys.exit(f"--scenarios: choose from {sorted(sets)}")
-    return sets[count]
+    return sets[count] + (lock_diagonal(scene, corners) if diagonal else [])
 
 
-def solve(scene, scenarios, intervals, jump_weight, t_max_margin=0.0, aggregate="mean"):
+def solve(scene, scenarios, intervals, weights, t_max_margin=0.0, aggregate="mean", presolve=PRESOLVE_INTERVALS):
     start = time.perf_counter()
     problem = RobustOCP(scene, scenarios, intervals=intervals, jump="penalty")
     problem.fastest_lockups()
     build = time.perf_counter() - start
     start = time.perf_counter()
-    result = problem.solve(weights={"jump": jump_weight}, t_max=problem.ocp.default_t_max(),
-                           t_max_margin=t_max_margin, aggregate=aggregate)
+    result = problem.solve(weights=weights, t_max=problem.ocp.default_t_max(),
+                           t_max_margin=t_max_margin, aggregate=aggregate, presolve_intervals=presolve or None)
     total = time.perf_counter() - start
     return problem, result, build, total
 
@@ -85,10 +90,11 @@ def label(overrides, centre):
                     for name in centre)
 
 
-def acceptance(scene, intervals, jump_weight, out, count=9, t_max_margin=0.0, aggregate="mean"):
+def acceptance(scene, intervals, weights, out, count=9, t_max_margin=0.0, aggregate="mean", diagonal=False,
+               presolve=PRESOLVE_INTERVALS):
     corners, centre = box_points(scene)
-    problem, robust, build, total = solve(scene, scenario_set(scene, count), intervals, jump_weight, t_max_margin,
-                                          aggregate)
+    problem, robust, build, total = solve(scene, scenario_set(scene, count, diagonal), intervals, weights,
+                                          t_max_margin, aggregate, presolve)
     t_max = problem.ocp.default_t_max()       # the limit the replays are judged by
     print(f"robust ({count} scenarios, {intervals} intervals): build {build:.1f} s, solve {total:.1f} s, "
           f"{robust.stats['iterations']} iterations", file=sys.stderr)
@@ -106,7 +112,8 @@ def acceptance(scene, intervals, jump_weight, out, count=9, t_max_margin=0.0, ag
                "robust_optimum": replay_numbers(simulate_command(s, robust.command_times, robust.command, t_end,
                                                                  model=model, control="linear"), t_max)}
         rows.append(row)
-    summary = {"t_max_s": t_max, "t_max_solved_s": robust.t_max, "aggregate": aggregate, "intervals": intervals, "jump_weight": jump_weight, "scenarios": count,
+    summary = {"t_max_s": t_max, "t_max_solved_s": robust.t_max, "aggregate": aggregate, "intervals": intervals,
+               "weights": weights, "scenarios": count + (len(robust.scenarios) - count),
                "robust_build_s": build, "corners": rows,
                "robust_solve_s": total, "robust_iterations": robust.stats["iterations"],
                "robust_collocation_jumps_Nm": [s.terms["lockup_torque_jump_Nm"] for s in robust.scenarios],
@@ -195,6 +202,12 @@ def main():
     parser.add_argument("--scenarios", type=int, nargs="*", default=[1, 3, 5, 9])
     parser.add_argument("--intervals", type=int, default=ROBUST_INTERVALS)
     parser.add_argument("--jump-weight", type=float, default=ROBUST_JUMP_WEIGHT)
+    parser.add_argument("--presolve", type=int, default=PRESOLVE_INTERVALS,
+                        help="command steps of the coarse presolve (0: none, start on the fine grid)")
+    parser.add_argument("--jerk-weight", type=float, default=1.0)
+    parser.add_argument("--smooth-weight", type=float, default=0.1)
+    parser.add_argument("--diagonal", action="store_true",
+                        help="add the lock_diagonal points of the box (first to last corner to lock) to every set")
     parser.add_argument("--acceptance", type=int, default=None, metavar="SCENARIOS",
                         help="solve with this scenario set (1, 3, 5, 9) and replay at the 9 box points")
     parser.add_argument("--t-max-margin", type=float, default=ROBUST_T_MAX_MARGIN,
@@ -203,20 +216,22 @@ def main():
                         help="open-loop Monte Carlo of the 9-point robust command and the baseline (samples/s)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--aggregate", choices=("mean", "worst"), default=ROBUST_AGGREGATE)
+    parser.add_argument("--aggregate", choices=AGGREGATES, default=ROBUST_AGGREGATE)
     parser.add_argument("--out", default="out/bench_robust")
     parser.add_argument("--json", help="also write the results to this JSON file")
     args = parser.parse_args()
     scene = default_scene()
-    report = {"timing": [], "settings": {"intervals": args.intervals, "jump_weight": args.jump_weight,
+    weights = {"jump": args.jump_weight, "jerk": args.jerk_weight, "smooth": args.smooth_weight}
+    report = {"timing": [], "settings": {"intervals": args.intervals, "presolve": args.presolve, "weights": weights,
+                                         "diagonal": args.diagonal,
                                          "t_max_margin": args.t_max_margin, "aggregate": args.aggregate}}
     print(f"{'scenarios':>9s} {'build [s]':>10s} {'solve [s]':>10s} {'iterations':>10s} {'IPOPT runs':>10s} "
           f"{'IPOPT [s/iteration]':>19s}")
     solved = {}
     for count in args.scenarios:
         try:
-            _, result, build, total = solve(scene, scenario_set(scene, count), args.intervals, args.jump_weight,
-                                            args.t_max_margin, args.aggregate)
+            _, result, build, total = solve(scene, scenario_set(scene, count, args.diagonal), args.intervals,
+                                            weights, args.t_max_margin, args.aggregate, args.presolve)
             solved[count] = result
         except ClutchocpError as exc:
             report["timing"].append({"scenarios": count, "failed": str(exc)})
@@ -231,8 +246,8 @@ def main():
     if args.montecarlo:
         robust = solved.get(9)
         if robust is None:
-            robust = solve(scene, scenario_set(scene, 9), args.intervals, args.jump_weight, args.t_max_margin,
-                           args.aggregate)[1]
+            robust = solve(scene, scenario_set(scene, 9, args.diagonal), args.intervals, weights,
+                           args.t_max_margin, args.aggregate, args.presolve)[1]
         mc = montecarlo(scene, robust, args.montecarlo, args.seed, args.workers)
         report["montecarlo"] = mc
         print(f"Monte Carlo, open loop: {mc['samples']} samples (seed {mc['seed']}), {mc['workers']} workers, "
@@ -243,8 +258,8 @@ def main():
                   f" |jump| [% of locked torque] median {j['median']:.1f} / p95 {j['p95']:.1f} / worst {j['worst']:.1f}")
         print(f"  robust worst |jump| / baseline worst |jump| = {mc['worst_jump_over_baseline']:.3f} (target <= 0.5)")
     if args.acceptance is not None:
-        acc = acceptance(scene, args.intervals, args.jump_weight, Path(args.out), args.acceptance, args.t_max_margin,
-                         args.aggregate)
+        acc = acceptance(scene, args.intervals, weights, Path(args.out), args.acceptance, args.t_max_margin,
+                         args.aggregate, args.diagonal, args.presolve)
         report["acceptance"] = acc
         print(f"t_max = {acc['t_max_s']:.4f} s")
         print(f"{'corner':>26s} | {'baseline':>18s} | {'nominal optimum':>18s} | {'robust optimum':>18s}")

@@ -5,8 +5,10 @@ import numpy as np
 import pytest
 
 from clutchocp.errors import ModelError
+from clutchocp.optimal import robust
+from clutchocp.optimal.clamp import ClampModel
 from clutchocp.optimal.problem import OBJECTIVE_TERMS, SLIP_MODE, EngagementOCP, check_weights
-from clutchocp.optimal.robust import ParametricOCP, RobustOCP, solve_robust
+from clutchocp.optimal.robust import SWEEP_CAPACITY, ParametricOCP, RobustOCP, lock_diagonal, solve_robust
 from clutchocp.scene import default_scene
 
 N = 10                # no coarse presolve (PRESOLVE_INTERVALS) below this
@@ -163,3 +165,56 @@ def test_a_value_the_model_cannot_take_as_a_symbol_is_named(scene, nominal):
     with pytest.raises(ModelError, match="plates.n_interfaces"):
         ParametricOCP(scene, ("plates.n_interfaces",), intervals=3, baseline=ocp.baseline)
     assert isinstance(ca.SX.sym("x"), ca.SX)
+
+
+def test_worst_jump_of_one_scenario_is_the_mean_with_the_jump_penalty(scene, monkeypatch):
+    """aggregate='worst_jump' with one scenario: the epigraph z = |jump| / locked torque is tight, so the
+    objective is w_jump (jump / locked)^2 + the other terms, the jump penalty of the mean aggregate (whose
+    one-scenario problem is the nominal one; the locked torque of this driveline is a constant). Both
+    from the same start: the problem is not convex (this one from the nominal start ends at 1.45, from
+    the sweep start at 1.13)."""
+    monkeypatch.setattr(robust, "STARTS", ("sweep",))
+    weights = {"jump": 30.0}
+    res = solve_robust(scene, [{}], intervals=N, jump="penalty", weights=weights, aggregate="worst_jump")
+    ref = solve_robust(scene, [{}], intervals=N, jump="penalty", weights=weights, aggregate="mean")
+    assert res.success and ref.success
+    assert res.objective == pytest.approx(ref.objective, rel=1e-6)
+    assert res.lock_times[0] == pytest.approx(ref.lock_times[0], rel=1e-6)
+    terms = res.scenarios[0].terms
+    assert terms["lockup_torque_jump_Nm"] == pytest.approx(ref.scenarios[0].terms["lockup_torque_jump_Nm"], rel=1e-5)
+    # the epigraph variable is the relative jump of the scenario
+    assert res.w[-1] == pytest.approx(abs(terms["lockup_torque_jump_Nm"] / terms["locked_torque_Nm"]), rel=1e-6)
+
+
+def test_the_sweep_start_runs_through_the_capacity_band(scene, nominal):
+    """Start "sweep": the pressure limit, a drop one valve time constant before the fastest scenario would
+    lock under it, then a ramp from the command whose settled capacity is SWEEP_CAPACITY x the locked
+    torque of the strongest clutch to the one of the weakest, at t_max; both scenarios lock under it,
+    the stronger first."""
+    ocp, opt = nominal
+    mu = scene.value("friction.mu")
+    weak, strong = scene.with_overrides({"friction.mu": 0.9 * mu}), scene.with_overrides({"friction.mu": 1.1 * mu})
+    problem = RobustOCP(scene, [{"friction.mu": 0.9 * mu}, {"friction.mu": 1.1 * mu}], intervals=N,
+                        baseline=ocp.baseline)
+    problem._weights = check_weights(None)
+    times, values = problem._sweep_command(opt.t_max)
+    lag = scene.value("actuation.time_constant")
+    assert values[1] == values[2] == problem.ocp.p_max
+    assert times[2] == pytest.approx(problem.fastest_lockups()[1] - lag, rel=1e-12)
+    assert times[4] == opt.t_max
+    for clutch, p in ((strong, values[3]), (weak, values[4])):      # capacity = 1.5 x locked torque
+        clamp = ClampModel(clutch)
+        assert clamp.capacity(p) == pytest.approx(SWEEP_CAPACITY * clamp.locked_torque(), rel=1e-6)
+    problem._start = "sweep"
+    lock = [r.summary["engagement_time_s"] for r in problem.start_runs(opt.t_max)]
+    assert lock[1] < lock[0]
+
+
+def test_lock_diagonal_runs_from_the_first_to_the_last_corner_to_lock(scene):
+    mu = scene.value("friction.mu")
+    corners = [{"friction.mu": 0.9 * mu, "load.torque": 80.0}, {"friction.mu": 1.1 * mu, "load.torque": 120.0}]
+    points = lock_diagonal(scene, corners, fractions=(0.25,))
+    # the stronger clutch locks first: a quarter of the way from it
+    assert points == [pytest.approx({"friction.mu": 1.05 * mu, "load.torque": 110.0}, rel=1e-12)]
+    with pytest.raises(ModelError, match="fractions"):
+        lock_diagonal(scene, corners, fractions=(0.5, 1.0))

@@ -33,7 +33,22 @@ Lock-up torque jump: each scenario may meet the nominal jump condition (``jump="
 default of :class:`~clutchocp.optimal.problem.EngagementOCP`), but one command can rarely make
 every scenario lock tangentially (measured: infeasible on the centre and the two extreme corners
 of the default box), so the robust use is ``jump="penalty"`` with a ``jump`` weight: the jump of
-every scenario is an objective term.
+every scenario is an objective term. ``aggregate="worst_jump"`` puts the largest jump in its place:
+an epigraph variable z >= |locked - slipping| / locked torque of every scenario at its lock-up (the
+share the Monte Carlo reports), and the objective w_jump z^2 + the mean of the scenarios' other
+terms (jerk, smooth, ...). With one scenario this is the nominal jump penalty (the locked torque of
+a driveline is a constant), checked in the tests.
+
+Why one command cannot land every clutch without a jump (a two-inertia driveline, slip w_rel from
+w_0, inertias J1, J2, locked torque T_L): the slip falls as w_rel' = (T_L - T_c)(1/J1 + 1/J2), so a
+clutch whose slipping torque is g times a common T(t) (g: its friction) locks when
+g F(t) = T_L (t + t_0), with F the integral of T and t_0 = w_0 / ((1/J1 + 1/J2) T_L) (0.23 s on
+the default scene), and its jump share is d ln R / d ln(t + t_0) with R = F / (t + t_0). R must
+rise by ln(g_max / g_min) (0.2 for mu +-10 %) between the first lock-up t_a and the last t_b, so
+the worst jump share is at least ln(g_max / g_min) / ln((t_b + t_0) / (t_a + t_0)): the command
+has to land the fastest clutch early and sweep slowly through the others. The "sweep" start
+(:meth:`RobustOCP.start_runs`) is built that way, and :func:`lock_diagonal` adds scenarios between
+the first and the last corner to lock, so that the worst jump between the box points is held too.
 
 One dynamics function for all scenarios. The uncertain scene values are symbols of the model
 (:class:`clutchocp.scene.symbolic.SymbolicScene`): :class:`ParametricOCP` builds the scaled dynamics, objective and end
@@ -58,18 +73,24 @@ from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
 from ..scene.symbolic import SymbolicScene
+from .clamp import ClampModel
 from .collocation import _repeat_columns, _sparse
 from .derivatives import IPOPT_OPTIONS, WARM_OPTIONS
 from .guess import guess_from_run
 from .problem import OBJECTIVE_TERMS, SLIP_MODE, EngagementOCP, OptimalEngagement, check_weights
 from .replay import simulate_command
 
-AGGREGATES = ("mean", "worst")
+AGGREGATES = ("mean", "worst", "worst_jump")
 PRESOLVE_INTERVALS = 10
 # IPOPT iterations per solve: on the 9-point default box every converged solve took at most 68; the
 # failing ones crawled on with a singular-looking step (regularisation ~1e7) to the default limit of 500
 MAX_ITERATIONS = 200
-STARTS = ("nominal", "ramp", "baseline")      # start points tried in turn (see RobustOCP.start_runs)
+STARTS = ("nominal", "ramp", "baseline", "sweep")      # start points tried in turn (see RobustOCP.start_runs)
+# Start "sweep": the ramp of the command runs through the commands whose settled capacity is this
+# multiple of each scenario's locked torque (the slipping torque a jump of that share leaves)
+SWEEP_CAPACITY = 1.5
+# Positions on the box diagonal from the first to the last corner to lock of the points lock_diagonal adds
+DIAGONAL_FRACTIONS = (0.25, 0.75)
 
 
 class ParametricOCP(EngagementOCP):
@@ -117,6 +138,15 @@ class ParametricOCP(EngagementOCP):
                              ) from None
         finally:
             self.model = numeric
+        # The jump as a share of the scenario's own locked torque, (locked - slipping) / locked at the
+        # end state (the measure of the Monte Carlo): the rows of the worst-jump epigraph.
+        xs, us = ca.SX.sym("xs", self.x0.size + 1), ca.SX.sym("us")
+        theta = [self.theta] if self.theta.numel() else []
+        values = out["outputs_fn"](xs, us, *theta)
+        locked = values[out["output_names"].index("locked_torque_Nm")]
+        slipping = values[out["output_names"].index("total_torque_Nm")]
+        out["relative_jump_fn"] = ca.Function("relative_jump", [xs, us, self.theta],
+                                              [(locked - slipping) / locked])
         if self.theta.numel():
             jump_theta = out["jump_fn"]
             out["jump_fn"] = lambda x, u: jump_theta(x, u, self.theta_value)
@@ -289,8 +319,9 @@ class RobustOCP:
             within t_max [-, in [0, 0.5)].
         weights : dict, optional
             Objective weights by term (``OBJECTIVE_TERMS``), the same for every scenario.
-        aggregate : {"mean", "worst"}
-            Weighted mean of the scenario objectives, or the worst (epigraph).
+        aggregate : {"mean", "worst", "worst_jump"}
+            Weighted mean of the scenario objectives, the worst (epigraph), or w_jump x the largest
+            (|jump| / locked torque)^2 plus the weighted mean of the other terms (epigraph).
         scenario_weights : sequence of float, optional
             Weights of the scenarios in the mean (normalised; default equal).
         max_shifts : int
@@ -336,6 +367,10 @@ class RobustOCP:
                              f"{self.overrides[k]} ({fastest[k]:.4g} s with a step to actuation.max_pressure); "
                              "raise t_max or the pressure limit")
         stages, start = [], None
+        # the sweep start is built for the worst-jump objective and goes first there (on the 9-point default
+        # box, 10 steps, jump weight 100, jerk 1, margin 0.05: worst |jump| 85 % from a hand-set sweep, 98 % from
+        # the nominal start)
+        starts = (("sweep",) + tuple(k for k in STARTS if k != "sweep")) if aggregate == "worst_jump" else STARTS
         if presolve_intervals is not None and presolve_intervals < self.intervals:
             coarse = RobustOCP(self.scene, self.overrides, intervals=presolve_intervals,
                                **dict(self._ocp_options, polish=False, baseline=ocp.baseline))
@@ -343,14 +378,14 @@ class RobustOCP:
             # The problem is not convex: the presolve runs from every start and keeps the lowest objective
             # (two scenarios mu +-5 %, 12 steps, mean: 4.07 from the ramp start, 4.66 from the nominal one).
             start = None
-            for kind in STARTS:
+            for kind in starts:
                 coarse._start = kind
                 found = coarse._solve_model(coarse.ocp, t_max, weights, aggregate, omega, None, max_shifts, stages,
                                             f"smooth, {presolve_intervals} intervals, start {kind}")
                 if found.success and (start is None or found.objective < start.objective):
                     start = found
         # From the presolve's solution if there is one, else (or if that fails) from each start in turn.
-        for kind, guess in ([(None, start)] if start is not None else []) + [(k, None) for k in STARTS]:
+        for kind, guess in ([(None, start)] if start is not None else []) + [(k, None) for k in starts]:
             if kind is not None:
                 self._start = kind
             result = self._solve_model(ocp, t_max, weights, aggregate, omega, guess, max_shifts, stages,
@@ -426,12 +461,19 @@ class RobustOCP:
         9-point box infeasible from the baseline; two scenarios 5 % apart in mu on 10 command steps
         converged from the baseline but not from the ramp within 500 iterations; the 9-point box on
         20 steps converged from the ramp and not with the baseline tried first). :meth:`solve` tries
-        the ramp first and the baseline if that fails. Re-solves then move the lock-ups.
+        the ramp first and the baseline if that fails. Re-solves then move the lock-ups. Start
+        "sweep" (first for ``aggregate="worst_jump"``, last otherwise; see the module notes): the
+        pressure limit until one valve time constant before the fastest scenario would lock under
+        it, then a linear sweep from the lowest to the highest of the scenarios' commands whose
+        settled capacity is ``SWEEP_CAPACITY`` x their locked torque, reached at t_max (measured on
+        the 9 box points, 10 steps, jump weight 100, jerk 1, margin 0.05: worst jump 85 % from a sweep
+        of this shape set by hand, 98 % from the nominal start).
         """
         key = (float(t_max), self._start)
         if getattr(self, "_start_key", None) != key:
             h_c = t_max / self.intervals
             opt = self.nominal_optimum(t_max) if self._start == "nominal" else None
+            sweep = self._sweep_command(t_max) if self._start == "sweep" else None
             if opt is not None:
                 # the nominal optimum, then a ramp at the rate limit to the pressure limit, so that the
                 # scenarios it leaves slipping (the weak corners) lock up too
@@ -441,7 +483,11 @@ class RobustOCP:
                 values = np.append(opt.command, self.ocp.p_max)
                 self._start_runs = [simulate_command(s, times, values, 2.0 * t_max, control="linear")
                                     for s in self.scenes]
-            elif self._start in ("nominal", "ramp"):    # (a nominal optimum that failed: the ramp)
+            elif sweep is not None:
+                times, values = sweep
+                self._start_runs = [simulate_command(s, times, values, 2.0 * t_max, control="linear")
+                                    for s in self.scenes]
+            elif self._start in ("nominal", "ramp", "sweep"):    # (no nominal optimum or sweep: the ramp)
                 times, values = [0.0, h_c], [self.ocp.scene.value("actuation.initial_pressure"), self.ocp.p_max]
                 self._start_runs = [simulate_command(s, times, values, 2.0 * t_max, control="linear")
                                     for s in self.scenes]
@@ -453,6 +499,26 @@ class RobustOCP:
             self._start_key = key
             self._start_command = (times, values)
         return self._start_runs
+
+    def _sweep_command(self, t_max):
+        """Start "sweep": the pressure limit until one valve time constant before the fastest scenario
+        would lock under it, then a ramp over [SWEEP_CAPACITY x balance] from the lowest scenario's to the
+        highest scenario's by t_max, then the pressure limit: (times [s], command [Pa]), or None if the
+        scenes have no clamp model (balance = the command whose settled capacity is the locked torque)."""
+        try:
+            clamps = [ClampModel(s).clamp_pressure(SWEEP_CAPACITY) for s in self.scenes]
+        except ModelError:
+            return None
+        p_a, p_b = min(clamps), max(clamps)
+        ocp = self.ocp
+        rate = ocp.rate_limit if np.isfinite(ocp.rate_limit) else np.inf
+        rise = max(t_max / self.intervals, ocp.p_max / rate)
+        lag = self.scene.get("actuation.time_constant", 0.0) or rise
+        t_drop = max(float(self.fastest_lockups().min()) - lag, rise)
+        t_sweep = min(t_drop + max(lag, (ocp.p_max - p_a) / rate), 0.5 * (t_drop + t_max))
+        times = [0.0, rise, t_drop, t_sweep, t_max, t_max + max(ocp.p_max - p_b, 0.0) / rate + 1e-9]
+        values = [self.scene.value("actuation.initial_pressure"), ocp.p_max, ocp.p_max, p_a, p_b, ocp.p_max]
+        return np.array(times), np.array(values)
 
     def nominal_optimum(self, t_max):
         """The nominal scene's optimum on this command grid (smooth model, the weights of the solve;
@@ -483,6 +549,8 @@ class RobustOCP:
         p = np.concatenate([[weights[k] for k in OBJECTIVE_TERMS], self.thetas.ravel(), omega])
         if aggregate == "worst" and not warm:                 # the epigraph variable starts on its bound
             w0[nlp.tau_slice.stop:] = np.max(np.array(nlp.objectives_fn(w0, p)))
+        elif aggregate == "worst_jump" and not warm:
+            w0[nlp.tau_slice.stop:] = np.max(np.abs(np.array(nlp.jumps_fn(w0, p))))
         solver = self.solver(nlp, warm)
         start = time.perf_counter()
         with interrupt.in_solver():
@@ -609,6 +677,7 @@ class _RobustNLP:
     command_grid: np.ndarray           # scaled times of the command nodes
     objectives_fn: ca.Function         # (w, p) -> J_s of each scenario
     tau_min: float
+    jumps_fn: ca.Function              # (w, p) -> (locked - slipping) / locked torque at each lock-up
 
     @property
     def t_upper(self):
@@ -683,7 +752,7 @@ def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
     Xc = [ca.MX.sym(f"Xc{s}", n_x, int(n_ints[s]) * d) for s in range(n_s)]
     V = ca.MX.sym("V", n_int + 1)
     tau_s = ca.MX.sym("tau", n_s)
-    z = ca.MX.sym("z", 1 if aggregate == "worst" else 0)
+    z = ca.MX.sym("z", 1 if aggregate in ("worst", "worst_jump") else 0)
     W = ca.MX.sym("weights", len(OBJECTIVE_TERMS))
     Theta = ca.MX.sym("theta", n_th, n_s)
     omega = ca.MX.sym("omega", n_s)
@@ -721,7 +790,9 @@ def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
     xdot, q, c = prob.dynamics.map(n_pts)(ca.horzcat(*Xc), Uc, P_pts)
 
     B = np.asarray(tr.B)
-    colloc, continuity, g_end, J_s = [], [], [], []
+    colloc, continuity, g_end, J_s, J_rest, jumps = [], [], [], [], [], []
+    no_jump = np.ones(len(OBJECTIVE_TERMS))
+    no_jump[OBJECTIVE_TERMS.index("jump")] = 0.0
     col = 0
     for s in range(n_s):
         ni = int(n_ints[s])
@@ -740,6 +811,10 @@ def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
         u_f = V[int(K[s])] + (V[int(K[s]) + 1] - V[int(K[s])]) * tau_s[s] / h_c
         p_s = ca.vertcat(W, Theta[:, s])
         J_s.append(prob.objective(Xs[:, -1], u_f, Q, T_s, p_s))
+        if aggregate == "worst_jump":
+            # the scenario's other terms (its jump term off: the worst jump takes its place)
+            J_rest.append(prob.objective(Xs[:, -1], u_f, Q, T_s, ca.vertcat(W * no_jump, Theta[:, s])))
+        jumps.append(ocp.relative_jump_fn(Xs[:, -1], u_f, Theta[:, s]))
         g_end.append(prob.end(Xs[:, -1], u_f, T_s, p_s))
     J_all = ca.vertcat(*J_s)
     n_e = prob.end_lb.size
@@ -763,6 +838,12 @@ def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
     if aggregate == "worst":
         f = z
         blocks.append((J_all - z, -np.inf, 0.0))
+    elif aggregate == "worst_jump":
+        # epigraph of the largest |jump| / locked torque: -z <= jump_s <= z (z >= 0 follows)
+        jump_all = ca.vertcat(*jumps)
+        f = W[OBJECTIVE_TERMS.index("jump")] * z**2 + ca.dot(omega, ca.vertcat(*J_rest))
+        blocks.append((ca.vertcat(jump_all - z, jump_all + z), np.r_[np.full(n_s, -np.inf), np.zeros(n_s)],
+                       np.r_[np.zeros(n_s), np.full(n_s, np.inf)]))
     else:
         f = ca.dot(omega, J_all)
     g = ca.vertcat(*[b[0] for b in blocks])
@@ -784,8 +865,46 @@ def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
     P = ca.vertcat(W, ca.vec(Theta), omega)
     nlp = {"x": w, "f": f, "g": g, "p": P}
     objectives_fn = ca.Function("scenario_objectives", [w, P], [J_all])
+    jumps_fn = ca.Function("scenario_jumps", [w, P], [ca.vertcat(*jumps)])
     return _RobustNLP(nlp, lbx, ubx, lbg, ubg, x_offsets, xc_offsets, v_slice, tau_slice, n_x, d, np.asarray(tau),
-                      h_c, tuple(int(k) for k in K), grid, objectives_fn, tau_min)
+                      h_c, tuple(int(k) for k in K), grid, objectives_fn, tau_min, jumps_fn)
+
+
+def lock_diagonal(scene, corners, fractions=DIAGONAL_FRACTIONS):
+    """Scenarios inside the box on the segment from the corner that locks first to the one that locks last.
+
+    One shared command lands each clutch at its own lock-up time, and its jump depends mostly on that
+    time; the box points leave gaps in the lock-up times (on the default box the centre locks 40 ms
+    before the slowest corners), where the command of a worst-jump solve is free to bulge (measured:
+    worst |jump| 81 % on the 9 box points, 95 % over 200 draws between them). Points on this diagonal
+    fill the gaps.
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+    corners : list of dict
+        Override dicts of the box corners (``Uncertainty.corners()``), SI values.
+    fractions : sequence of float
+        Positions on the segment, 0 = the first corner to lock, 1 = the last, each in (0, 1).
+
+    Returns
+    -------
+    list of dict
+        One override dict per fraction (numeric fields interpolated linearly).
+    """
+    fractions = [float(f) for f in fractions]
+    if not all(0.0 < f < 1.0 for f in fractions):
+        raise ModelError(f"fractions {fractions}: positions on the diagonal are in (0, 1)")
+    if len(corners) < 2 or not fractions:
+        return []
+    p_max = scene.value("actuation.max_pressure")
+    t_end = scene.value("simulation.t_end")
+    times = []
+    for d in corners:
+        t = simulate_command(scene.with_overrides(d), [0.0], [p_max], t_end).summary["engagement_time_s"]
+        times.append(np.inf if t is None else t)
+    first, last = corners[int(np.argmin(times))], corners[int(np.argmax(times))]
+    return [{name: first[name] + f * (last[name] - first[name]) for name in first} for f in fractions]
 
 
 def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean", intervals=60, degree=3,
@@ -805,7 +924,9 @@ def solve_robust(scene, scenarios, *, t_max=None, weights=None, aggregate="mean"
         scenarios still lock within t_max (``RobustEngagement.t_max`` is that bound, ``.t_limit`` t_max).
     weights : dict, optional
         Objective weights by term (jerk, energy, time, jump, smooth).
-    aggregate : {"mean", "worst"}
+    aggregate : {"mean", "worst", "worst_jump"}
+        Weighted mean of the scenario objectives, the largest one, or w_jump x the largest
+        (|jump| / locked torque)^2 plus the mean of the other terms.
     intervals, degree : int
         Steps of the command grid over [0, t_max] and collocation points per interval.
     scenario_weights : sequence of float, optional

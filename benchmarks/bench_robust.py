@@ -22,9 +22,9 @@ samples per second (both strategies per sample).
 Defaults are the settings of ``clutchocp robust`` (``ROBUST_*`` in clutchocp/shiftcontrol/report.py).
 Run from the repository root:
 
-    python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 10] [--presolve 10] [--jump-weight 100]
-        [--jerk-weight 1] [--smooth-weight 0.1] [--aggregate mean|worst|worst_jump] [--diagonal]
-        [--t-max-margin 0.05] [--montecarlo 200 --seed 0 --workers 2] [--acceptance SCENARIOS] [--out DIR]
+    python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 12] [--presolve 0] [--jump-weight 1000]
+        [--jerk-weight 0.1] [--smooth-weight 0.01] [--aggregate mean|worst|worst_jump] [--no-diagonal]
+        [--t-max-margin 0.02] [--montecarlo 200 --seed 0 --workers 2] [--acceptance SCENARIOS] [--out DIR]
         [--json FILE]
 
 The worst-jump feedforward of the README: ``--scenarios 9 --diagonal --aggregate worst_jump --jump-weight 1000
@@ -46,7 +46,7 @@ from clutchocp.optimal.robust import AGGREGATES, PRESOLVE_INTERVALS, RobustOCP, 
 from clutchocp.optimal.replay import CommandModel, simulate_command
 from clutchocp.output import new_figure, save_figure
 from clutchocp.scene import default_scene
-from clutchocp.shiftcontrol.report import ROBUST_AGGREGATE, ROBUST_INTERVALS, ROBUST_JUMP_WEIGHT, ROBUST_T_MAX_MARGIN
+from clutchocp.shiftcontrol.report import ROBUST_AGGREGATE, ROBUST_INTERVALS, ROBUST_T_MAX_MARGIN, ROBUST_WEIGHTS
 
 def box_points(scene):
     """(corners, centre) of the scene's uncertainty box as override dicts [SI]."""
@@ -201,12 +201,13 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenarios", type=int, nargs="*", default=[1, 3, 5, 9])
     parser.add_argument("--intervals", type=int, default=ROBUST_INTERVALS)
-    parser.add_argument("--jump-weight", type=float, default=ROBUST_JUMP_WEIGHT)
-    parser.add_argument("--presolve", type=int, default=PRESOLVE_INTERVALS,
-                        help="command steps of the coarse presolve (0: none, start on the fine grid)")
-    parser.add_argument("--jerk-weight", type=float, default=1.0)
-    parser.add_argument("--smooth-weight", type=float, default=0.1)
-    parser.add_argument("--diagonal", action="store_true",
+    parser.add_argument("--jump-weight", type=float, default=ROBUST_WEIGHTS["jump"])
+    parser.add_argument("--presolve", type=int, default=0,
+                        help=f"command steps of the coarse presolve (0, the default: none, start on the fine grid; "
+                             f"the solver's own default is {PRESOLVE_INTERVALS})")
+    parser.add_argument("--jerk-weight", type=float, default=ROBUST_WEIGHTS["jerk"])
+    parser.add_argument("--smooth-weight", type=float, default=ROBUST_WEIGHTS["smooth"])
+    parser.add_argument("--diagonal", action=argparse.BooleanOptionalAction, default=True,
                         help="add the lock_diagonal points of the box (first to last corner to lock) to every set")
     parser.add_argument("--acceptance", type=int, default=None, metavar="SCENARIOS",
                         help="solve with this scenario set (1, 3, 5, 9) and replay at the 9 box points")

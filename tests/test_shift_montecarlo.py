@@ -82,7 +82,7 @@ def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch)
         return SimpleNamespace(success=True, command_times=opt.command_times, command=opt.command,
                                scenarios=[opt], stats={"status": "stand-in"})
 
-    monkeypatch.setattr(report, "robust_solver", lambda: stand_in)
+    monkeypatch.setattr(report, "robust_solver", lambda: (stand_in, lambda scene, corners: [corners[0]]))
     spec = replace(load_slip_spec(), t_max_fraction=1.0, schedule_field="")
     strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene),
                                                 spec, intervals=30, say=lambda *a: None)
@@ -92,7 +92,7 @@ def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch)
     strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene),
                                                 spec, intervals=30, say=lambda *a: None)
     assert facts["closed_loop"]["feedforward"] == "robust_feedforward"
-    assert len(seen["scenarios"]) == 9                       # 2^3 corners and the centre
+    assert len(seen["scenarios"]) == 10                      # 2^3 corners, the centre and the diagonal's point
     assert facts["robust_feedforward"]["stats"] == {"status": "stand-in"}
 
 

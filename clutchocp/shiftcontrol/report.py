@@ -38,23 +38,25 @@ COLOURS = {"baseline": "tab:gray", "nominal_optimum": "tab:blue", "robust_feedfo
            "closed_loop": "tab:red"}
 
 
-# The robust feedforward over the box points, with the settings it converges with on the default scene
-# (README, "Robust feedforward"): 10 command steps (20 stopped in IPOPT), the worst scenario's objective,
-# the jump as a penalty (the jump condition of optimize is infeasible over the box), and every scenario
-# locked by 0.95 t_max, so that the clutches between them lock within t_max.
-ROBUST_INTERVALS = 10
-ROBUST_JUMP_WEIGHT = 100.0
-ROBUST_AGGREGATE = "worst"
-ROBUST_T_MAX_MARGIN = 0.05
+# The robust feedforward over the box points and two points on the diagonal between the first and the
+# last corner to lock, with the settings it converges with on the default scene (README, "Robust
+# feedforward"): 12 command steps without a presolve (15 took 777 s, 20 stopped in IPOPT), the worst
+# |jump| share as the objective (epigraph) with small jerk and smoothness weights, the jump as a
+# penalty (the jump condition of optimize is infeasible over the box), and every scenario locked by
+# 0.98 t_max, so that the clutches between them lock within t_max.
+ROBUST_INTERVALS = 12
+ROBUST_WEIGHTS = {"jump": 1000.0, "jerk": 0.1, "smooth": 0.01}
+ROBUST_AGGREGATE = "worst_jump"
+ROBUST_T_MAX_MARGIN = 0.02
 
 
 def robust_solver():
-    """``solve_robust`` of the robust feedforward (contract: clutchocp.optimal.robust), or None if not installed."""
+    """(``solve_robust``, ``lock_diagonal``) of the robust feedforward (clutchocp.optimal.robust), or None if not installed."""
     try:
-        from ..optimal.robust import solve_robust
+        from ..optimal.robust import lock_diagonal, solve_robust
     except ImportError:
         return None
-    return solve_robust
+    return solve_robust, lock_diagonal
 
 
 def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=print):
@@ -83,20 +85,21 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
     feedforward = ("nominal_optimum", opt.command_times, opt.command)
     facts = {"t_max_s": t_max, "nominal_optimum": {k: opt.terms[k] for k in
                                                    ("engagement_time_s", "jerk_integral", "lockup_torque_jump_Nm")}}
-    solve_robust, rob = robust_solver(), None
-    if solve_robust is None:
+    robust, rob = robust_solver(), None
+    if robust is None:
         facts["robust_feedforward"] = "not available: clutchocp.optimal.robust is not installed"
         say("  robust feedforward: not available (clutchocp.optimal.robust is not installed); skipped")
     else:
-        scenarios = uncertainty.corners() + [uncertainty.centre()]
+        solve_robust, lock_diagonal = robust
+        corners = uncertainty.corners()
+        scenarios = corners + [uncertainty.centre()] + lock_diagonal(scene, corners)
         say(f"  robust feedforward over {len(scenarios)} scenarios ({ROBUST_INTERVALS} intervals, {ROBUST_AGGREGATE} "
-            f"scenario, jump as a penalty of weight {ROBUST_JUMP_WEIGHT:g}, lock-up by "
-            f"{1 - ROBUST_T_MAX_MARGIN:g} t_max)")
+            f"objective, jump weight {ROBUST_WEIGHTS['jump']:g}, lock-up by {1 - ROBUST_T_MAX_MARGIN:g} t_max)")
         try:
             # one command rarely lets every scenario lock without a jump: the jump is a penalty
             rob = solve_robust(scene, scenarios, t_max=t_max, intervals=ROBUST_INTERVALS, jump="penalty",
-                               weights={"jump": ROBUST_JUMP_WEIGHT}, aggregate=ROBUST_AGGREGATE,
-                               t_max_margin=ROBUST_T_MAX_MARGIN)
+                               weights=ROBUST_WEIGHTS, aggregate=ROBUST_AGGREGATE,
+                               t_max_margin=ROBUST_T_MAX_MARGIN, presolve_intervals=None)
             failure = None if rob.success else f"IPOPT stopped with {rob.stats.get('status')}"
         except SolverError as exc:
             failure = str(exc)
@@ -112,7 +115,7 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         if spec.feedforward_curve == "robust":
             feedforward = ("robust_feedforward", np.asarray(rob.command_times), np.asarray(rob.command))
         facts["robust_feedforward"] = {"scenarios": len(scenarios), "intervals": ROBUST_INTERVALS,
-                                       "aggregate": ROBUST_AGGREGATE, "jump_weight": ROBUST_JUMP_WEIGHT,
+                                       "aggregate": ROBUST_AGGREGATE, "weights": ROBUST_WEIGHTS,
                                        "t_max_margin": ROBUST_T_MAX_MARGIN,
                                        "lock_times_s": [float(s.t_f) for s in rob.scenarios],
                                        "stats": {k: v for k, v in rob.stats.items()

@@ -82,6 +82,14 @@ def test_adaptation_gives_the_clutch_met_the_nominal_slip_rate():
     assert weak[0] == pytest.approx(1.5)
 
 
-def test_estimator_needs_two_rigid_rotors():
+def test_estimator_needs_two_rigid_rotors_and_a_valve_state():
+    from clutchocp.shiftcontrol.design import _adaptation_unavailable
+
     with pytest.raises(ModelError, match=r"driveline\.input = \"inertia\""):
         TorqueEstimator.from_scene(load_scene("zhang2021"), TS)
+    bao = load_scene("bao2020")                 # prescribed input speed, step actuation
+    assert "driveline.input" in TorqueEstimator.unavailable(bao)
+    assert "no p_valve state" in _adaptation_unavailable(bao, ("w_in", "w_out", "h_1"))
+    default = default_scene()
+    assert TorqueEstimator.unavailable(default) is None
+    assert _adaptation_unavailable(default, ("w_in", "w_out", "p_valve")) is None

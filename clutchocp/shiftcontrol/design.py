@@ -49,6 +49,7 @@ class SlipFeedbackDesign:
     P: np.ndarray                      # (N + 1, n + 1, n + 1) cost-to-go
     state_names: tuple
     spec: object
+    adaptation_off: str | None = None  # why the spec's adaptation cannot run on this scene (None: it runs or is off)
 
 
 def pressure_limits(scene, spec):
@@ -194,12 +195,25 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
         peak = int(np.argmax(w_slip))
         fall = slice(peak, None)
         path = (np.append(t_slip[fall], t_lock), np.append(w_slip[fall], 0.0))
-    adaptation = _adaptation(scene, spec, sample_times[:N], state_at, lin.all_states) if spec.estimator["enabled"] \
-        else None
+    adaptation, adaptation_off = None, None
+    if spec.estimator["enabled"]:
+        adaptation_off = _adaptation_unavailable(scene, lin.all_states)
+        if adaptation_off is None:
+            adaptation = _adaptation(scene, spec, sample_times[:N], state_at, lin.all_states)
     feedback = SlipFeedback(Ts, gains, K[:, 0, n], ref, slip_ref, measured, (times, values), p_lo, p_hi,
                             (p_hi - p_lo) / spec.rate_limit_time, spec.anti_windup, path=path,
                             max_delay=spec.max_delay, adaptation=adaptation)
-    return SlipFeedbackDesign(feedback, nominal, t_lock, sample_times, Phi, Gamma, K, P, lin.state_names, spec)
+    return SlipFeedbackDesign(feedback, nominal, t_lock, sample_times, Phi, Gamma, K, P, lin.state_names, spec,
+                              adaptation_off)
+
+
+def _adaptation_unavailable(scene, state_names):
+    """Why the feedforward adaptation cannot run on a scene's model (one line), or None."""
+    missing = [name for name in ("w_in", "w_out", "p_valve") if name not in state_names]
+    if missing:
+        return (f"the model has no {', '.join(missing)} state (the estimator needs both rotor speeds and the valve "
+                "pressure: actuation.model = \"valve_lag\")")
+    return TorqueEstimator.unavailable(scene)
 
 
 def _adaptation(scene, spec, sample_times, state_at, state_names):
@@ -209,10 +223,6 @@ def _adaptation(scene, spec, sample_times, state_at, state_names):
     clutch (rows 0 and N repeat their neighbours: no estimate exists before t_1, and the TCU hands over at the
     first sample after lock-up).
     """
-    missing = [name for name in ("w_in", "w_out", "p_valve") if name not in state_names]
-    if missing:
-        raise ModelError(f"estimator.enabled = true: the scene's model has no {', '.join(missing)} state "
-                         "(the estimator needs both rotor speeds and the valve pressure: actuation.model = \"valve_lag\")")
     estimator = TorqueEstimator.from_scene(scene, spec.sample_time)
     states = np.array([state_at(t) for t in sample_times])
     columns = [states[:, state_names.index(name)] for name in ("w_in", "w_out", "p_valve")]

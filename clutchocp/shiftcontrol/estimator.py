@@ -44,16 +44,22 @@ class TorqueEstimator:
     input_torque: float
     sample_time: float
 
+    @staticmethod
+    def unavailable(scene):
+        """Why a scene's driveline has no estimator (a one-line reason), or None if it has one."""
+        if scene.get("driveline.input") != "inertia" or scene.get("driveline.output", "inertia") != "inertia":
+            return ("needs driveline.input = \"inertia\" and driveline.output = \"inertia\" (the clutch torque is "
+                    "read from both rotors' accelerations)")
+        if scene.get("driveline.shaft_stiffness") is not None:
+            return "driveline.shaft_stiffness is set; the estimator assumes rigid rotors"
+        return None
+
     @classmethod
     def from_scene(cls, scene, sample_time):
         """The estimator of a two-inertia scene (``driveline.input = "inertia"``, ``output = "inertia"``, rigid)."""
-        if scene.get("driveline.input") != "inertia" or scene.get("driveline.output", "inertia") != "inertia":
-            raise ModelError("slip feedback estimator: needs driveline.input = \"inertia\" and driveline.output = "
-                             "\"inertia\" (the clutch torque is read from both rotors' accelerations); set "
-                             "[estimator] enabled = false for this scene")
-        if scene.get("driveline.shaft_stiffness") is not None:
-            raise ModelError("slip feedback estimator: driveline.shaft_stiffness is set; the estimator assumes "
-                             "rigid rotors; set [estimator] enabled = false for this scene")
+        reason = cls.unavailable(scene)
+        if reason is not None:
+            raise ModelError(f"slip feedback estimator: {reason}; set [estimator] enabled = false for this scene")
         return cls(scene.value("driveline.input_inertia"), scene.value("driveline.output_inertia"),
                    scene.value("driveline.input_torque"), sample_time)
 

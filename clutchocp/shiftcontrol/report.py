@@ -147,7 +147,10 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
     say(f"  slip feedback on the {ff_label}: {spec.label}, Ts = {spec.sample_time * 1e3:g} ms"
         + (f", scheduled on {spec.schedule_field} ({spec.schedule_points} points)" if spec.schedule_field else ""))
     schedule = design_schedule(scene, spec, uncertainty, feedforward_for, say=say)
-    traits = [t for t, on in (("adaptive", spec.estimator["enabled"]),
+    adaptive = spec.estimator["enabled"] and schedule.adaptation_off is None
+    if schedule.adaptation_off is not None:
+        say(f"  feedforward adaptation off on this scene: {schedule.adaptation_off}")
+    traits = [t for t, on in (("adaptive", adaptive),
                                (f"{len(schedule.feedbacks)} designs over {schedule.field}", bool(schedule.field))) if on]
     strategies.append(Strategy("closed_loop", f"slip feedback on {ff_label}"
                                + (f" ({', '.join(traits)})" if traits else ""),
@@ -156,7 +159,7 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
                             "controller": spec.label, "sample_time_s": spec.sample_time,
                             "nominal_lock_s": schedule.lock_times[schedule.index(scene)],
                             "progress": spec.progress, "measured": list(schedule.feedbacks[0].measured),
-                            "estimator": bool(spec.estimator["enabled"]),
+                            "estimator": bool(adaptive), "estimator_off": schedule.adaptation_off,
                             "schedule": {"field": schedule.field, "values": [float(v) for v in schedule.values
                                                                              if np.isfinite(v)],
                                          "lock_times_s": schedule.lock_times}}

@@ -35,6 +35,8 @@ class FeedbackSchedule:
         The scene overrides each design was made on (``{}`` without a schedule).
     lock_times : list of float
         Lock-up time of each design's feedforward on its own scene [s].
+    adaptation_off : str or None
+        Why the spec's feedforward adaptation cannot run on the scene (None: it runs, or the spec has it off).
     """
 
     field: str
@@ -42,6 +44,7 @@ class FeedbackSchedule:
     feedbacks: list
     overrides: list
     lock_times: list
+    adaptation_off: str | None = None
 
     def index(self, scene):
         """Index of the grid value nearest a clutch's own value of the field (0 without a schedule)."""
@@ -115,7 +118,7 @@ def design_schedule(scene, spec, uncertainty, feedforward_for, *, say=print):
     """
     values = schedule_values(scene, spec, uncertainty)
     overrides = [{spec.schedule_field: float(v)} for v in values] or [{}]
-    feedbacks, lock_times = [], []
+    feedbacks, lock_times, adaptation_off = [], [], None
     for i, override in enumerate(overrides):
         design_scene = scene.with_overrides(override) if override else scene
         if override:
@@ -124,5 +127,6 @@ def design_schedule(scene, spec, uncertainty, feedforward_for, *, say=print):
         design = design_slip_feedback(design_scene, times, command, spec)
         feedbacks.append(design.feedback)
         lock_times.append(float(design.t_lock))
+        adaptation_off = design.adaptation_off
     return FeedbackSchedule(spec.schedule_field if values else "", np.asarray(values, float) if values
-                            else np.array([np.nan]), feedbacks, overrides, lock_times)
+                            else np.array([np.nan]), feedbacks, overrides, lock_times, adaptation_off)

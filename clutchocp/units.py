@@ -13,6 +13,7 @@ e.g. a sample rate, 1 Hz = 1/s). Temperatures (fields in deg C, ``dimension="deg
 ``degC``, ``K`` or ``degF``; ``deg`` alone is an angle and is refused there.
 """
 
+import functools
 import math
 import re
 
@@ -85,10 +86,13 @@ _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s
 _FACTOR = re.compile(r"^([^\s^*/]+?)(?:(?:\^|\*\*)([-+]?\d+))?$")
 
 
+@functools.lru_cache(maxsize=1024)
 def _parse_unit(expr, field, angular=False):
     """Return (factor to SI, dimension) of a unit expression such as ``"kg/m^3"``.
 
     ``angular``: the field is an angular speed, so a frequency in Hz counts 2 pi rad per cycle.
+    Cached: a sweep re-reads the same scene's unit strings at every point (the result depends on
+    the arguments alone; a unit that does not parse raises each time, errors are not cached).
     """
     text = expr.replace("·", " ").replace("**", "^")
     text = re.sub(r"\s*\^\s*", "^", text)

@@ -51,3 +51,20 @@ def test_bad_units_name_the_field(text, dim, needle):
     with pytest.raises(UnitError, match="my.field") as info:
         to_si(text, dim, "my.field")
     assert needle in str(info.value)
+
+
+def test_cached_unit_parse_equals_a_fresh_parse_and_keeps_refusing():
+    """The unit parse is cached (a sweep re-reads its scene at every point): the cached answer is
+    the uncached function's, the Hz rule still depends on the field, and a unit that does not
+    parse is refused every time with the field that asked."""
+    from clutchocp.units import _parse_unit
+
+    for text in ("kg/m^3", "N/mm", "mPa s", "Hz", "1/m^2"):
+        for angular in (False, True):
+            assert _parse_unit(text, "a.b", angular) == _parse_unit.__wrapped__(text, "a.b", angular)
+    assert to_si("1 Hz", "rad/s", "drive.speed") == pytest.approx(2 * math.pi, rel=1e-15)
+    assert to_si("1 Hz", "1/s", "tcu.rate") == 1.0
+    for field in ("oil.viscosity", "oil.density"):
+        for _ in range(2):
+            with pytest.raises(UnitError, match=f"^{field}: unit 'Pa x'"):
+                to_si("0.04 Pa x", "Pa s", field)

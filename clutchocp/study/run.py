@@ -9,7 +9,7 @@ from ..errors import ModelError
 from ..output import write_summary
 from ..scene import load_scene
 from ..simulation.native import native_status
-from .executor import StudyInterrupted, check_engine, default_workers, execute
+from .executor import StudyInterrupted, check_engine, default_workers, execute, frozen_heap
 from .figures import draw_study
 from .folder import StudyFolder
 from .points import StudySpecError, chains, grid_points, parse_grid, point_id
@@ -97,7 +97,7 @@ def run_sweep(scene, out_dir, *, task="simulate", grid=(), samples=None, seed=0,
             "options": job.options}
     out = Path(out_dir)
     start = time.perf_counter()
-    with StudyFolder(out, spec, columns) as folder:
+    with StudyFolder(out, spec, columns) as folder, frozen_heap():     # through the figures too
         done = {row["point_id"] for row in folder.finished()}
         todo = [p for p in points if point_id(p) not in done]
         if task == "optimize" and grid:             # one path through the grid per worker: warm starts

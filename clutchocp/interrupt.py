@@ -121,3 +121,23 @@ def _make_callback():
             return [1 if _state["requested"] else 0]
 
     return _StopOnInterrupt()
+
+
+def ignore_sigint():
+    """Initialiser of a worker process: Ctrl-C is handled by the parent, which stops the workers."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextmanager
+def sigint_held():
+    """Hold Ctrl-C back while worker processes are forked: a SIGINT during a fork runs its handler
+    inside the fork hooks, where the exception is lost; held, it is delivered after the block.
+    The workers start with it held and ignore it (:func:`ignore_sigint`)."""
+    held = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
+    if held:
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        if held:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})

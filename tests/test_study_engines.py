@@ -128,3 +128,78 @@ def test_a_heap_frozen_before_the_sweep_stays_frozen():
             pass
         assert gc.get_freeze_count() > 0                    # the inner block does not unfreeze the outer's
     assert gc.get_freeze_count() == 0
+
+
+_REFERENCE_CALLS = {}         # pid -> what the patched usual run did (the child's is copied back by a file)
+
+
+def _reference_off_by_one_per_cent(task, point, settings):
+    """A usual run that disagrees with the parametric one (1 % on the peak torque)."""
+    import os
+    from pathlib import Path
+
+    numbers = _REAL_REFERENCE[0](task, point, settings)
+    (Path(_REFERENCE_CALLS["dir"]) / f"ref_{os.getpid()}.txt").write_text("called")
+    return dict(numbers, peak_torque_Nm=numbers["peak_torque_Nm"] * 1.01)
+
+
+def _reference_failing_in_the_child(task, point, settings):
+    import os
+
+    if os.getpid() != _REFERENCE_CALLS["parent"]:
+        raise RuntimeError("the child's usual run failed")
+    return _REAL_REFERENCE[0](task, point, settings)
+
+
+_REAL_REFERENCE = []
+
+
+@pytest.fixture
+def warm_task(tmp_path, monkeypatch):
+    import os
+
+    from clutchocp.study import tasks
+
+    if start_method() != "fork":
+        pytest.skip("the usual run is made beside the warm-up only where processes are forked")
+    tasks.clear_caches()
+    _REAL_REFERENCE[:] = [tasks._reference_numbers]
+    _REFERENCE_CALLS.update(dir=tmp_path, parent=os.getpid())
+    yield tasks, tasks.Task("zhang2021", "simulate", options={"native": False})
+    tasks.clear_caches()
+
+
+POINTS = [{"actuation.pressure": 4e5, "oil.viscosity": v} for v in (0.07, 0.08)]
+
+
+def test_the_warm_up_checks_its_model_against_a_usual_run_made_in_a_second_process(warm_task, tmp_path,
+                                                                                   monkeypatch):
+    import os
+
+    tasks, task = warm_task
+    monkeypatch.setattr(tasks, "_reference_numbers", _reference_off_by_one_per_cent)
+    done, rest = tasks.warm_up(task, [[p] for p in POINTS])
+    callers = [p.name for p in tmp_path.glob("ref_*.txt")]
+    assert callers and f"ref_{os.getpid()}.txt" not in callers            # made by the forked process
+    assert done[0][0]["status"] == "ok" and done[0][0]["model_reused"] is False   # the disagreement counted
+    assert rest == [[POINTS[1]]] and not tasks._REFERENCES
+    assert tasks.simulate_point(task, POINTS[1])[0]["model_reused"] is False      # one model per point from now
+
+
+def test_a_usual_run_that_fails_beside_the_warm_up_is_made_again_in_the_sweep_process(warm_task, monkeypatch):
+    tasks, task = warm_task
+    monkeypatch.setattr(tasks, "_reference_numbers", _reference_failing_in_the_child)
+    done, _ = tasks.warm_up(task, [[p] for p in POINTS])
+    assert done[0][0]["status"] == "ok" and done[0][0]["model_reused"] is True
+
+
+def test_a_usual_run_not_needed_by_the_warm_up_is_stopped(warm_task, monkeypatch):
+    import multiprocessing
+
+    from clutchocp.study import parametric
+
+    tasks, task = warm_task
+    monkeypatch.setattr(parametric, "build", lambda scene, names: None)     # no reused model: nothing to check
+    done, _ = tasks.warm_up(task, [[p] for p in POINTS])
+    assert done[0][0]["status"] == "ok" and done[0][0]["model_reused"] is False
+    assert not tasks._REFERENCES and not multiprocessing.active_children()

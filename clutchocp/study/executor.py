@@ -24,13 +24,12 @@ import contextlib
 import gc
 import multiprocessing
 import os
-import signal
 import sys
-import threading
 
 from tqdm import tqdm
 
 from ..errors import ClutchocpError, ModelError
+from ..interrupt import ignore_sigint, sigint_held
 from .tasks import run_unit, warm_up
 
 ENGINES = ("local", "dask", "serial")
@@ -70,26 +69,6 @@ class _Bar(tqdm):
 
 class EngineError(ClutchocpError, RuntimeError):
     """The execution engine could not be started or reached (e.g. no scheduler at the address)."""
-
-
-def _ignore_sigint():
-    """Worker initialiser: Ctrl-C is handled by the parent, which stops the workers."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-@contextlib.contextmanager
-def _sigint_held():
-    """Hold Ctrl-C back while worker processes are forked: a SIGINT during a fork runs its handler
-    inside the fork hooks, where the exception is lost; held, it is delivered after the block.
-    The workers start with it held and ignore it (:func:`_ignore_sigint`)."""
-    held = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
-    if held:
-        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        if held:
-            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 @contextlib.contextmanager
@@ -229,8 +208,8 @@ def _run_local(task, units, deliver, workers):
     n = max(1, min(workers, len(units)))
     if not units:
         return {"engine": "local", "workers": n, "start_method": method}
-    with _sigint_held():
-        pool = multiprocessing.get_context(method).Pool(n, initializer=_ignore_sigint)
+    with sigint_held():
+        pool = multiprocessing.get_context(method).Pool(n, initializer=ignore_sigint)
     try:
         for results in pool.imap_unordered(_run_units_args, [(task, b) for b in batches(units, n)], chunksize=1):
             deliver(results)

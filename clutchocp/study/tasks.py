@@ -140,7 +140,18 @@ def warm_up(task, units):
     if task.kind != "simulate" or not units:
         return [], units
     first, rest = units[0][:1], [units[0][1:]] + list(units[1:])
-    return run_unit(task, first), [u for u in rest if u]
+    _reference_beside(task, first[0])
+    try:
+        done = run_unit(task, first)
+    finally:
+        _drop_references()
+    return done, [u for u in rest if u]
+
+
+def _run_settings(task):
+    """The integration settings of a simulate task's runs."""
+    opts = task.options
+    return {"rtol": opts["rtol"], "atol": opts["atol"], "output_points": opts["output_points"]}
 
 
 def simulate_point(task, point):
@@ -151,7 +162,7 @@ def simulate_point(task, point):
 
     opts = task.options
     has_compiler = compiler() is not None                       # no compiler: the VM, silently
-    settings = {"rtol": opts["rtol"], "atol": opts["atol"], "output_points": opts["output_points"]}
+    settings = _run_settings(task)
     start = time.perf_counter()
     try:
         scene = point_scene(task, point)
@@ -176,6 +187,85 @@ def simulate_point(task, point):
 
 
 _PARAMETRIC = {}        # this worker's parametric models: key -> [ParametricModel or None, checked]
+_REFERENCES = {}        # point_id -> (process, connection): a usual run computed beside the warm-up
+
+
+def _parametric_key(task, point):
+    """Key of the parametric model that serves ``point`` (its scene, base overrides, swept names)."""
+    return (task.scene, tuple(sorted(task.base_overrides.items(), key=lambda kv: kv[0])), tuple(sorted(point)))
+
+
+def _reference_numbers(task, point, settings):
+    """What the usual run of ``point`` (a model of its own, CasADi's virtual machine) gives for the
+    numbers a parametric run is checked against (:func:`clutchocp.study.parametric.agrees`)."""
+    from ..engagement.run import simulate_engagement
+    from . import parametric
+
+    summary = simulate_engagement(point_scene(task, point), **dict(settings, native=False)).summary
+    return {key: summary[key] for key in (*parametric.COMPARED, "final_mode")}
+
+
+def _send_reference(connection, task, point, settings):
+    """Body of the process that runs the usual run beside the warm-up."""
+    from ..interrupt import ignore_sigint
+
+    ignore_sigint()                          # Ctrl-C is the parent's, which stops this process
+    try:
+        connection.send(("ok", _reference_numbers(task, point, settings)))
+    except Exception:                        # the warm-up runs it again itself and meets the error there
+        connection.send(("failed", None))
+    finally:
+        connection.close()
+
+
+def _reference_beside(task, point):
+    """Start the usual run of the warm-up's first point in a forked process, beside this one.
+
+    The warm-up builds the parametric model and runs the point on it (~0.06 s for zhang2021), then
+    checks it against the usual run (~0.05 s); with the usual run in a second process the two
+    share the cores instead of following each other (the other core is idle while the sweep's
+    first point runs). Started only where the point will be checked (a reused model not yet built
+    in this process) and where processes are forked."""
+    import multiprocessing
+
+    from ..interrupt import sigint_held
+
+    if not (task.options["reuse_model"] and all(isinstance(v, float) for v in point.values())) \
+            or _parametric_key(task, point) in _PARAMETRIC or "fork" not in multiprocessing.get_all_start_methods():
+        return
+    context = multiprocessing.get_context("fork")
+    receive, send = context.Pipe(duplex=False)
+    process = context.Process(target=_send_reference, args=(send, task, point, _run_settings(task)), daemon=True)
+    with sigint_held():                      # held until the child ignores it
+        process.start()
+    send.close()
+    _REFERENCES[point_id(point)] = (process, receive)
+
+
+def _reference(task, point, settings):
+    """The usual run's numbers of ``point``: from the process started beside the warm-up, else run here."""
+    pending = _REFERENCES.pop(point_id(point), None)
+    if pending is not None:
+        process, connection = pending
+        try:
+            status, numbers = connection.recv()
+        except EOFError:                     # the process died
+            status = "failed"
+        finally:
+            connection.close()
+            process.join()
+        if status == "ok":
+            return numbers
+    return _reference_numbers(task, point, settings)
+
+
+def _drop_references():
+    """Stop the processes started beside the warm-up whose result was not needed."""
+    while _REFERENCES:
+        process, connection = _REFERENCES.popitem()[1]
+        connection.close()
+        process.terminate()
+        process.join()
 
 
 def _simulate_reusing(task, point, scene, settings):
@@ -188,7 +278,7 @@ def _simulate_reusing(task, point, scene, settings):
     names = tuple(sorted(point))
     if not all(isinstance(point[n], float) for n in names):
         return None
-    key = (task.scene, tuple(sorted(task.base_overrides.items(), key=lambda kv: kv[0])), names)
+    key = _parametric_key(task, point)
     entry = _PARAMETRIC.get(key)
     if entry is None:
         entry = _PARAMETRIC[key] = [parametric.build(point_scene(task, {}), names), False]
@@ -200,8 +290,7 @@ def _simulate_reusing(task, point, scene, settings):
     except Exception:
         return None
     if not entry[1]:                          # the first point: check against the usual run once
-        reference = simulate_engagement(scene, **dict(settings, native=False))
-        if not parametric.agrees(run.summary, reference.summary):
+        if not parametric.agrees(run.summary, _reference(task, point, settings)):
             entry[0] = None
             return None
         entry[1] = True

@@ -71,6 +71,9 @@ class EngineError(ClutchocpError, RuntimeError):
     """The execution engine could not be started or reached (e.g. no scheduler at the address)."""
 
 
+_FROZEN = {"depth": 0}      # frozen_heap blocks open in this process
+
+
 @contextlib.contextmanager
 def frozen_heap():
     """Keep the objects this process holds out of the garbage collector's full collections while
@@ -85,12 +88,16 @@ def frozen_heap():
     advises for fork: the workers then neither rescan the pages they inherit nor copy them by
     writing the collector's marks into them.
     """
-    frozen_before = gc.get_freeze_count() > 0
+    outermost = _FROZEN["depth"] == 0
+    # counted only at the outermost block: gc.get_freeze_count walks the frozen objects (7 ms)
+    hand_back = outermost and gc.get_freeze_count() == 0
+    _FROZEN["depth"] += 1
     gc.freeze()
     try:
         yield
     finally:
-        if not frozen_before:
+        _FROZEN["depth"] -= 1
+        if hand_back:
             gc.unfreeze()
 
 

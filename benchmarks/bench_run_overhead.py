@@ -89,46 +89,62 @@ def _timers(acc):
         compiled.native_events_outputs = merged
 
 
-def evaluation_floor(task, values, repeats=5):
-    """The least time a point must spend outside IDAS evaluating the functions its result needs on
-    many samples at once (outputs on the output grid, event functions on its samples, merged where
-    the tree merges them): every such call of one point on each of ``values`` is recorded (its
-    arguments copied) and replayed ``repeats`` times, keeping each call's fastest replay. Calls on a
-    single sample (guards, resets, located events) are left out, so this is a lower bound.
+def point_floor(task, values, repeats=5):
+    """What a point cannot spend less on outside IDAS without changing its results, per value of
+    the oil viscosity in ``values``:
+
+    * evaluating the functions its result needs on many samples at once (outputs on the output
+      grid, event functions on its samples, merged where the tree merges them): every such call is
+      recorded (arguments copied) and replayed ``repeats`` times, keeping each call's fastest
+      replay; calls on one sample (guards, resets, located events) are left out (a lower bound);
+    * building the IDAS integrators the point needs for output patterns this process has not met
+      (the locked phase's count follows the lock-up time; an integrator of another count changes
+      the outputs, see README-engine): the time of each ``casadi.integrator`` construction.
 
     Returns
     -------
-    list of (float, float)
-        Per value: (floor [s], the point's integrator time [s]).
+    list of dict
+        Per value: ``evaluations_s``, ``construction_s``, ``integrators_built``, ``integration_s``.
     """
+    import casadi
+
     from clutchocp.simulation.compiled import ColumnFunction
     from clutchocp.study.tasks import simulate_point
 
-    inner = ColumnFunction.__call__
-    recorded = []
+    inner, build = ColumnFunction.__call__, casadi.integrator
+    recorded, built = [], []
 
     def recording(self, xs, zs, pu, t):
         if np.atleast_1d(np.asarray(t, float)).size >= 2:
             recorded.append((self, *(np.array(a, float, copy=True) for a in (xs, zs, pu, t))))
         return inner(self, xs, zs, pu, t)
 
+    def timed_build(*args):
+        start = time.perf_counter()
+        try:
+            return build(*args)
+        finally:
+            built.append(time.perf_counter() - start)
+
     out = []
     for v in values:
         recorded.clear()
-        ColumnFunction.__call__ = recording
+        built.clear()
+        ColumnFunction.__call__, casadi.integrator = recording, timed_build
         try:
             row = simulate_point(task, {"oil.viscosity": v})[0]
         finally:
-            ColumnFunction.__call__ = inner
-        floor = 0.0
+            ColumnFunction.__call__, casadi.integrator = inner, build
+        evaluations = 0.0
         for function, *args in recorded:
             best = math.inf
             for _ in range(repeats):
                 start = time.perf_counter()
                 inner(function, *args)
                 best = min(best, time.perf_counter() - start)
-            floor += best
-        out.append((floor, row["integration_time_s"]))
+            evaluations += best
+        out.append({"evaluations_s": evaluations, "construction_s": sum(built), "integrators_built": len(built),
+                    "integration_s": row["integration_time_s"]})
     return out
 
 
@@ -173,9 +189,15 @@ def worker(scene, native, points, warm_up):
     for a, b in zip(values[warm_up - 1:], values[warm_up:]):  # new values: nothing cached from the first pass
         simulate_point(task, {"oil.viscosity": 0.5 * (a + b)})
     second = time.perf_counter() - start
-    floors = evaluation_floor(task, [0.5 * (a + b) for a, b in zip(values[warm_up:-1], values[warm_up + 1:])])
-    return {"floor_ms": 1e3 * statistics.median(f for f, _ in floors),
-            "floor_share": statistics.median(f / (f + i) for f, i in floors),
+    # values met by neither pass (their output patterns are new to this process, as a new sweep point's are)
+    floors = point_floor(task, [(2 * a + b) / 3 for a, b in zip(values[warm_up - 1:], values[warm_up:])])
+    floor = [f["evaluations_s"] + f["construction_s"] for f in floors]
+    return {"floor_evaluations_ms": 1e3 * statistics.median(f["evaluations_s"] for f in floors),
+            "floor_construction_ms": 1e3 * statistics.median(f["construction_s"] for f in floors),
+            "floor_integrators_built": statistics.median(f["integrators_built"] for f in floors),
+            "floor_share": statistics.median(c / (c + f["integration_s"]) for c, f in zip(floor, floors)),
+            "floor_evaluations_share": statistics.median(f["evaluations_s"] / (f["evaluations_s"] + f["integration_s"])
+                                                         for f in floors),
             "share": statistics.median(1 - i / r for i, r in zip(integ, run)),
             "cpu_share": statistics.median(cpu_shares), "cpu_point_ms": 1e3 * statistics.median(cpu_points),
             "cpu_point_min_ms": 1e3 * min(cpu_points), "point_min_ms": 1e3 * min(run),

@@ -13,6 +13,11 @@ Numbers (written to ``bench_sweep.json`` and printed):
   figures included; the models and scenes this process holds from earlier sweeps are dropped
   before each timed sweep): ``T1 / (2 T2)``; target >= 0.85. ``parallel_efficiency_sweep_only``:
   the same from the sweeps' own ``wall_time_s`` (without the figures drawn at the end).
+  ``efficiency_bound_from_cpu``: what the measured CPU seconds of the 2-worker sweep allow
+  (:func:`efficiency_bound`: the sweep process's own CPU is serial, its workers' parallel).
+  ``two_at_once``: the share of two cores' throughput two forked processes get on this machine
+  (the same points alone and two at once, :func:`two_at_once`); ``efficiency_expected``: the two
+  together, what the sweep can reach here.
 * ``dask_over_local``: the same sweep on a Dask LocalCluster (2 worker processes, 1 thread each,
   started inside the timing) over the 2-worker local pool; target <= 1.2. The three sweeps run
   ``--rounds`` times (default 3), alternating, and the medians are compared (``runs_s``: each run).
@@ -56,6 +61,7 @@ from clutchocp.engagement.model import EngagementModel
 from clutchocp.engagement.run import simulate_engagement
 from clutchocp.scene import load_scene
 from clutchocp.study import run_sweep
+from clutchocp.study.executor import start_method
 from clutchocp.study.tasks import clear_caches
 from clutchocp.study.folder import RESULTS, TEXT_COLUMNS, parse_cell
 
@@ -102,6 +108,52 @@ def zhang_grid(points):
     return [f"actuation.pressure=0.3 MPa:0.6 MPa:{n_pressure}", f"oil.viscosity=0.04:0.08:{n_viscosity}"]
 
 
+def efficiency_bound(serial_s, parallel_s):
+    """The parallel efficiency on 2 workers that a sweep process's CPU time ``serial_s`` (first point,
+    rows, figures: nothing runs beside it) and its workers' CPU time ``parallel_s`` allow on an
+    otherwise idle machine (Amdahl): T1 = S + P, T2 = S + P / 2, T1 / (2 T2)."""
+    return (serial_s + parallel_s) / (2 * serial_s + parallel_s)
+
+
+def _points_per_second(task, points):
+    """Points per second of simulating ``points`` in this (forked) process."""
+    from clutchocp.study.tasks import simulate_point
+
+    start = time.perf_counter()
+    for point in points:
+        simulate_point(task, point)
+    return len(points) / (time.perf_counter() - start)
+
+
+def two_at_once(points, rounds=3):
+    """How much of two cores' throughput two processes get on this machine: the same zhang2021 points
+    (a reused model built here, the processes forked from this one, as a sweep's workers are) run
+    alone, one half after the other, and the two halves at once; per round
+    ``(rate of the two at once, summed) / (2 x rate alone)``. 1 on two independent cores; below 1
+    where the two share what a core needs (caches, memory bandwidth, a host's scheduling)."""
+    import multiprocessing
+
+    from clutchocp.study.points import grid_points, parse_grid
+    from clutchocp.study.tasks import Task, warm_up
+
+    scene = load_scene("zhang2021")
+    grid = grid_points([parse_grid(g, scene) for g in zhang_grid(points)])
+    task = Task("zhang2021", "simulate")
+    clear_caches()
+    warm_up(task, [grid[:1]])
+    halves = [(task, grid[1::2]), (task, grid[2::2])]
+    context = multiprocessing.get_context("fork")
+    out = []
+    for _ in range(rounds):
+        with context.Pool(1) as pool:
+            alone = [pool.apply(_points_per_second, half) for half in halves]
+        with context.Pool(2) as pool:
+            both = pool.starmap(_points_per_second, halves)
+        out.append(sum(both) / sum(alone))
+    clear_caches()
+    return {"rounds": [round(v, 4) for v in out], "median": statistics.median(out)}
+
+
 def parallel(work, points, options=None, rounds=3):
     grid = zhang_grid(points)
     out = {"points": None, "rounds": rounds, "load_before": load()}
@@ -125,8 +177,14 @@ def parallel(work, points, options=None, rounds=3):
                cpu_sweep_process_s={k: statistics.median(c[0] for c in cpu[k]) for k in runs},
                cpu_workers_s={k: statistics.median(c[1] for c in cpu[k]) for k in runs},
                parallel_efficiency=t1 / (2 * t2), dask_over_local=td / t2,
+               efficiency_bound_from_cpu=efficiency_bound(statistics.median(c[0] for c in cpu["local2"]),
+                                                          statistics.median(c[1] for c in cpu["local2"])),
                parallel_efficiency_sweep_only=s1 / (2 * s2), dask_over_local_sweep_only=sd / s2,
-               runs_per_second_per_core=out["points"] / t2 / 2, load_after=load())
+               runs_per_second_per_core=out["points"] / t2 / 2)
+    if start_method() == "fork":
+        out["two_at_once"] = two_at_once(points)
+        out["efficiency_expected"] = out["efficiency_bound_from_cpu"] * out["two_at_once"]["median"]
+    out["load_after"] = load()
     return out
 
 
@@ -150,7 +208,9 @@ def command_line(work, points, rounds=3):
     t1, t2, td = (statistics.median(wall[k]) for k in runs)
     out.update(local_1_worker_s=t1, local_2_workers_s=t2, dask_2_workers_s=td,
                runs_s={k: [round(v, 3) for v in wall[k]] for k in runs},
-               parallel_efficiency=t1 / (2 * t2), dask_over_local=td / t2, load_after=load())
+               parallel_efficiency=t1 / (2 * t2), dask_over_local=td / t2,
+               efficiency_bound_from_cpu=efficiency_bound(statistics.median(c[0] for c in cpu["local2"]),
+                                                          statistics.median(c[1] for c in cpu["local2"])), load_after=load())
     return out
 
 
@@ -274,6 +334,12 @@ def target_lines(result):
             lines.append(f"{label}: {value:.3f} (target {sense} {target}; {'met' if met else 'NOT met'}; "
                          f"load {result[part]['load_before']} -> {result[part]['load_after']})")
     if "parallel" in result:
+        lines.append(f"parallel efficiency the serial CPU allows (Amdahl): "
+                     f"{result['parallel']['efficiency_bound_from_cpu']:.3f}")
+        if "two_at_once" in result["parallel"]:
+            lines.append(f"two processes at once get {result['parallel']['two_at_once']['median']:.3f} of two cores' "
+                         f"throughput on this machine; with the Amdahl bound: "
+                         f"{result['parallel']['efficiency_expected']:.3f}")
         lines.append(f"runs per second per core: {result['parallel']['runs_per_second_per_core']:.1f}")
     for scene, share in result.get("reused_model_share_native", {}).items():
         lines.append(f"share outside the integrator, {scene}, reused model, native: {share['share']:.2f} "

@@ -203,3 +203,24 @@ def test_a_usual_run_not_needed_by_the_warm_up_is_stopped(warm_task, monkeypatch
     done, _ = tasks.warm_up(task, [[p] for p in POINTS])
     assert done[0][0]["status"] == "ok" and done[0][0]["model_reused"] is False
     assert not tasks._REFERENCES and not multiprocessing.active_children()
+
+
+def test_the_local_cluster_starts_with_quick_nanny_polling_and_hands_the_setting_back(tmp_path, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    from distributed.nanny import WorkerProcess
+
+    from clutchocp.study.executor import NANNY_START_POLL_S
+
+    before = WorkerProcess._init_msg_interval
+    seen = []
+    cluster = distributed.LocalCluster
+
+    def recording(*args, **kwargs):
+        seen.append(WorkerProcess._init_msg_interval)
+        return cluster(*args, **kwargs)
+
+    monkeypatch.setattr(distributed, "LocalCluster", recording)
+    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID[:1], engine="dask", workers=2, progress=False,
+                        options={"native": False})
+    assert summary["points_ok"] == 2 and seen == [NANNY_START_POLL_S] != [before]
+    assert WorkerProcess._init_msg_interval == before

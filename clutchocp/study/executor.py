@@ -49,6 +49,29 @@ LOCAL_CLUSTER_CONFIG = {
 }
 
 
+# How often the LocalCluster's nannies (in this process) look whether the worker process they
+# started has connected: distributed polls every 50 ms, so a worker ready after ~35 ms is seen only
+# at 50. Measured alone (2 forked workers): the cluster starts in 0.057-0.066 s at 2 ms against
+# 0.085-0.096 s at 50 ms.
+NANNY_START_POLL_S = 0.002
+
+
+@contextlib.contextmanager
+def _nanny_polling(interval):
+    """Set the nannies' start-up polling interval for the block (``WorkerProcess._init_msg_interval``
+    of distributed, where that version has it; otherwise nothing changes)."""
+    from distributed.nanny import WorkerProcess
+
+    before = getattr(WorkerProcess, "_init_msg_interval", None)
+    if before is not None:
+        WorkerProcess._init_msg_interval = interval
+    try:
+        yield
+    finally:
+        if before is not None:
+            WorkerProcess._init_msg_interval = before
+
+
 class StudyInterrupted(KeyboardInterrupt):
     """The study was stopped by Ctrl-C after ``done`` points (all of them written)."""
 
@@ -257,7 +280,8 @@ def _run_dask(task, units, deliver, workers, scheduler):
                 done, units = warm_up(task, units)
                 deliver(done)
                 gc.freeze()                 # what the warm-up built too (see frozen_heap)
-            with dask.config.set({"distributed.worker.multiprocessing-method": method, **LOCAL_CLUSTER_CONFIG}):
+            with dask.config.set({"distributed.worker.multiprocessing-method": method, **LOCAL_CLUSTER_CONFIG}), \
+                    _nanny_polling(NANNY_START_POLL_S):
                 cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                        dashboard_address=None)
             client = Client(cluster)

@@ -19,7 +19,9 @@ the summary; the parts overlap: event location includes its event functions and 
 each point and around each ``IdasPath._run``), ``cpu_point_ms`` a point's CPU time: on a machine
 shared with other jobs the wall times move with their load, the CPU times much less, and
 ``fastest_point_ms`` (the fastest point of all rounds, wall time) estimates a point's cost without
-the other jobs.
+the other jobs. ``floor_share`` is the share a point cannot go below without changing its
+results (:func:`point_floor`: its many-sample evaluations replayed at their fastest and the IDAS
+integrators its new output patterns need, against its time in IDAS).
 
 Every (scene, engine, tree) measurement is a fresh process; the trees alternate within each scene
 and each pair repeats ``--rounds`` times, so a change of the machine's load hits both alike. The

@@ -194,15 +194,22 @@ def test_a_usual_run_that_fails_beside_the_warm_up_is_made_again_in_the_sweep_pr
 
 
 def test_a_usual_run_not_needed_by_the_warm_up_is_stopped(warm_task, monkeypatch):
-    import multiprocessing
-
     from clutchocp.study import parametric
 
     tasks, task = warm_task
+    started = []
+
+    class Recording(dict):
+        def __setitem__(self, key, value):
+            started.append(value[0])
+            super().__setitem__(key, value)
+
+    monkeypatch.setattr(tasks, "_REFERENCES", Recording())
     monkeypatch.setattr(parametric, "build", lambda scene, names: None)     # no reused model: nothing to check
     done, _ = tasks.warm_up(task, [[p] for p in POINTS])
     assert done[0][0]["status"] == "ok" and done[0][0]["model_reused"] is False
-    assert not tasks._REFERENCES and not multiprocessing.active_children()
+    assert len(started) == 1 and not started[0].is_alive() and started[0].exitcode is not None
+    assert not tasks._REFERENCES
 
 
 def test_the_local_cluster_starts_with_quick_nanny_polling_and_hands_the_setting_back(tmp_path, monkeypatch):

@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from clutchocp.engagement.run import _first_crossing as first_crossing, simulate_engagement
+from clutchocp.engagement.measures import _first_crossing as first_crossing
+from clutchocp.engagement.run import simulate_engagement
 from clutchocp.scene.loader import load_scene
 
 

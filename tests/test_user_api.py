@@ -8,7 +8,7 @@ import pytest
 from matplotlib.figure import Figure
 
 import clutchocp
-from clutchocp.engagement import report as engagement_report
+from clutchocp.engagement import figures as engagement_figures
 from clutchocp.errors import ClutchocpError, PhysicalRangeError
 from clutchocp.optimal import report as optimal_report
 from clutchocp.optimal.bound import jerk_lower_bound, output_jerk_share
@@ -135,8 +135,8 @@ def legend_texts(fig):
 
 
 def test_spring_applied_pressure_figure_shows_the_piston_force(bao, monkeypatch, tmp_path):
-    figures = captured_figures(monkeypatch, engagement_report)
-    engagement_report.plot_engagement(bao, tmp_path)
+    figures = captured_figures(monkeypatch, engagement_figures)
+    engagement_figures.plot_engagement(bao, tmp_path)
     fig = figures["pressure.png"]
     force = [line for ax in fig.axes for line in ax.get_lines() if "piston" in str(line.get_label())]
     assert force and np.max(np.abs(force[0].get_ydata())) > 1.0          # kN, not a flat zero line
@@ -144,8 +144,8 @@ def test_spring_applied_pressure_figure_shows_the_piston_force(bao, monkeypatch,
 
 
 def test_film_figure_shows_the_early_transient(bao, monkeypatch, tmp_path):
-    figures = captured_figures(monkeypatch, engagement_report)
-    engagement_report.plot_engagement(bao, tmp_path)
+    figures = captured_figures(monkeypatch, engagement_figures)
+    engagement_figures.plot_engagement(bao, tmp_path)
     left = figures["gaps.png"].axes[0]
     assert left.get_xlim()[1] < 0.1 * bao.result.t[-1]          # the squeeze phase fills the panel
     assert all(any("lock-up at" in t for t in legend_texts(figures[name])) for name in figures)

@@ -75,15 +75,13 @@ def plot_engagement(run, out):
     fig, (ax0, ax) = new_figure(2, width=5.0)
     ax0.plot(t, res["pressure_Pa"] / 1e6, label="pressure")
     ax0.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{name}: actuation pressure")
-    if model.has_piston and model.scene.variant("piston") == "spring_applied":
+    if model.piston.spring_applied:
         ax0.set_title(f"{name}: release pressure (spring-applied piston)")
     if not np.any(res["pressure_Pa"]):
         ax0.text(0.5, 0.6, "the pressure stays 0:\nthe springs engage the clutch\n(force: right panel)",
                  transform=ax0.transAxes, ha="center", fontsize=9)
-    if model.has_piston:
-        ax.plot(t, res["piston_force_N"] / 1e3, color="C2", label="piston drive (springs and pressure)")
-    else:
-        ax.plot(t, res["pack_force_N"] / 1e3, color="C2", label="pressure force on the pack")
+    force, label = model.piston.force_output        # the piston's drive, or the pressure force on the pack
+    ax.plot(t, res[force] / 1e3, color="C2", label=label)
     ax.plot(t, res["contact_force_N"] / 1e3, color="C1", lw=1, label="asperity contact (each film carries it)")
     ax.set(xlabel="time [s]", ylabel="force [kN]", title="force pressing the plates")
     _mark_lockup(ax0, run)

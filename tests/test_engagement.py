@@ -103,6 +103,36 @@ def test_scene_without_piston_has_no_piston_states():
     assert all(not name.startswith("approach") for name in no_travel.modes)
 
 
+def test_the_piston_stand_in_presses_the_pack_with_the_pressure_force(runs):
+    """Without a piston the pack face carries p A (A the plate area: zhang2021 gives no actuation.area);
+    with one, the published drive is Bao Eq. 21 at the piston travel, k (preload - x0) - p A_piston, the
+    travel the state x0 while approaching and the free travel plus the films' closure once pressing."""
+    zhang = runs["zhang2021"]
+    scene = zhang.model.scene
+    area = math.pi * (scene.value("plates.r_outer") ** 2 - scene.value("plates.r_inner") ** 2)
+    assert np.allclose(zhang.result["pack_force_N"], zhang.result["pressure_Pa"] * area, rtol=1e-12, atol=0.0)
+    assert "piston_force_N" not in zhang.result.names()
+    bao = runs["bao2020"]
+    s = bao.model.scene
+    k = s.value("piston.spring_stiffness") * s.value("piston.spring_count")
+    res, n, H0 = bao.result, bao.model.n, s.value("pack.initial_gap")
+    closure = sum(H0 - res[f"h_{i + 1}_m"] for i in range(n))
+    pressing = np.array([str(mode).startswith("pressing") for mode in res.mode])
+    x0 = np.where(pressing, s.value("piston.travel_to_pack") + closure, res["x0"])
+    drive = k * (s.value("piston.spring_preload") - x0) - res["pressure_Pa"] * s.value("piston.area")
+    assert np.allclose(bao.result["piston_force_N"], drive, rtol=1e-12, atol=1e-9 * np.max(np.abs(drive)))
+
+
+def test_the_parts_of_a_model_are_read_only_views_of_the_scene():
+    for name in ("zhang2021", "bao2020"):
+        scene = load_scene(name)
+        model = EngagementModel(scene)
+        assert model.has_piston == scene.has("piston") and model.masses == (scene.variant("pack") == "masses")
+        assert model.travel == scene.get("piston.travel_to_pack", 0.0)
+        with pytest.raises(AttributeError):
+            model.has_piston = not model.has_piston
+
+
 def test_energy_accumulators_only_for_the_parts_a_scene_has():
     """zhang2021 has no piston (no seal), no load, no splines and a rigid shaft: six accumulators;
     bao2020 adds the piston seal; default_driveline has no piston but a load on its output and a

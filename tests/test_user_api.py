@@ -10,6 +10,7 @@ from matplotlib.figure import Figure
 import clutchocp
 from clutchocp.engagement import figures as engagement_figures
 from clutchocp.errors import ClutchocpError, PhysicalRangeError
+from clutchocp.optimal import figures as optimal_figures
 from clutchocp.optimal import report as optimal_report
 from clutchocp.optimal.bound import jerk_lower_bound, output_jerk_share
 from clutchocp.optimal.problem import check_weights
@@ -199,8 +200,8 @@ def test_lock_time_difference_is_located_not_read_off_the_command_grid(best):
 
 
 def test_baselines_figure_compares_at_the_engagement_time(best, monkeypatch, tmp_path):
-    figures = captured_figures(monkeypatch, optimal_report)
-    optimal_report.plot_optimum(tmp_path, best.scene, best.optimum, best.replay, best.ocp.baseline,
+    figures = captured_figures(monkeypatch, optimal_figures)
+    optimal_figures.plot_optimum(tmp_path, best.scene, best.optimum, best.replay, best.ocp.baseline,
                                 best.baselines, best.summary)
     right = figures["baselines.png"].axes[1]
     assert "engagement" in right.get_xlabel()

@@ -171,7 +171,7 @@ def montecarlo(scene, robust, samples, seed, workers):
     from clutchocp.shiftcontrol.design import pressure_limits
     from clutchocp.shiftcontrol.montecarlo import Strategy, parallel_map, run_sample, strategy_statistics
     from clutchocp.shiftcontrol.spec import load_slip_spec
-    from clutchocp.uncertainty import Uncertainty
+    from clutchocp.scene.uncertainty import Uncertainty
 
     spec = load_slip_spec()
     uncertainty = Uncertainty.from_scene(scene)

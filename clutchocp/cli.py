@@ -145,7 +145,7 @@ def _cmd_scenes(args):
 
 def _describe(scene):
     """Print a checked scene: its parts, their chosen variants and its uncertain fields."""
-    from .uncertainty import Uncertainty
+    from .scene.uncertainty import Uncertainty
 
     uncertainty = Uncertainty.from_scene(scene)
     print(f"{scene.name}: {scene.kind} scene, valid")

@@ -9,7 +9,7 @@ from clutchocp.errors import SceneError
 from clutchocp.scene import default_scene
 from clutchocp.shiftcontrol.montecarlo import Strategy, parallel_map, run_sample, strategy_statistics
 from clutchocp.shiftcontrol.report import run_robust
-from clutchocp.uncertainty import Uncertainty
+from clutchocp.scene.uncertainty import Uncertainty
 
 
 T_MAX = 0.3      # [s]; the constant 0.8 MPa command locks the nominal default scene at 0.285 s

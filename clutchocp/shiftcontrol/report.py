@@ -21,7 +21,7 @@ from ..optimal.baselines import baseline_label
 from ..optimal.problem import EngagementOCP
 from ..output import new_figure, save_figure, write_csv, write_summary
 from ..scene import default_scene, load_scene
-from ..uncertainty import Uncertainty
+from ..scene.uncertainty import Uncertainty
 from .closed_loop import post_lock_command
 from .design import pressure_limits
 from .montecarlo import HISTORY_STEP, Strategy, parallel_map, run_sample, strategy_statistics

@@ -6,7 +6,7 @@
    dynamics (:class:`~clutchocp.shiftcontrol.linearize.SlipLinearization`) and the output rows
    C_w (slip) and C_a (slip rate) at t_k.
 3. Augment with the slip-error integral xi_{k+1} = xi_k + Ts C_w dx_k and solve the finite-horizon
-   time-varying LQR (:func:`~clutchocp.shiftcontrol.tvlqr.tvlqr`) with the weights of the spec on
+   time-varying LQR (:func:`~clutchocp.control.lqr.tvlqr`) with the weights of the spec on
    scaled deviations (Bryson's rule): slip error / w_rel(0), slip-rate error / (w_rel(0) / t_lock),
    integral / (w_rel(0) t_lock), correction / pressure range; the terminal weight at lock-up is
    ``terminal_weight`` times the state weight there (a slip rate held at its nominal value at
@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..control.lqr import tvlqr
 from ..engagement.run import EngagementResult
 from ..errors import ModelError
 from ..optimal.guess import SLIP_MODE
@@ -30,7 +31,6 @@ from ..optimal.replay import CommandModel, simulate_command
 from .controller import SlipFeedback
 from .estimator import FeedforwardAdaptation, TorqueEstimator
 from .linearize import SlipLinearization
-from .tvlqr import tvlqr
 
 SUBSTEPS = 8            # sub-intervals per sample for the sample maps
 

@@ -258,7 +258,8 @@ def main(argv=None):
                 f"{name}: warning: {' '.join(str(message).split())}", file=sys.stderr)
             args = build_parser().parse_args(argv)
             name = f"clutchocp {args.command}"
-            from . import commands  # here: --help and a mistyped option answer without loading the models (0.3 s)
+            # imported here: --help and a mistyped option answer without loading the models (0.3 s)
+            from . import commands
             try:
                 code = getattr(commands, args.command)(args)
             except ClutchocpError:

@@ -142,7 +142,8 @@ def cycles(args):
 
 def control(args):
     """``clutchocp control SCENE``: HVD speed controller designed and checked."""
-    from .hvd.report import run_control  # here: python-control takes 0.4 s to import; control and robust alone need it
+    # imported here: python-control takes 0.4 s to import; control and robust alone need it
+    from .hvd.report import run_control
 
     run_control(args.scene, args.controller, out_dir=args.out)
     return 0
@@ -168,7 +169,8 @@ def optimize(args):
 
 def robust(args):
     """``clutchocp robust [SCENE]``: Monte Carlo of the shift-control strategies."""
-    from .shiftcontrol.report import run_robust  # here: python-control takes 0.4 s to import (see control)
+    # imported here: python-control takes 0.4 s to import (see control)
+    from .shiftcontrol.report import run_robust
 
     run_robust(args.scene, out_dir=args.out, samples=args.samples, seed=args.seed, uncertain=args.uncertain,
                t_max=args.t_max, controller=args.controller, workers=args.workers, intervals=args.intervals)

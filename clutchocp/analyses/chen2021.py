@@ -181,7 +181,9 @@ def reference_values(values, pressures, cof=None):
 
 
 def run(out_dir, scene=None):
-    """Run the Chen analysis on a scene (default: built-in ``chen2021``), write its CSV files (its figures: :mod:`clutchocp.analyses.figures`).
+    """Run the Chen analysis on a scene (default: built-in ``chen2021``), write its CSV files.
+
+    Its figures are drawn from the result by :mod:`clutchocp.analyses.figures`.
 
     Returns
     -------

@@ -159,7 +159,9 @@ def _crossing(x, y):
 
 
 def run(out_dir, scene=None):
-    """Run the Cui analysis on a scene (default: built-in ``cui2019``), write its CSV files (its figures: :mod:`clutchocp.analyses.figures`).
+    """Run the Cui analysis on a scene (default: built-in ``cui2019``), write its CSV files.
+
+    Its figures are drawn from the result by :mod:`clutchocp.analyses.figures`.
 
     Returns
     -------

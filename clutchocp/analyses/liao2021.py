@@ -163,7 +163,9 @@ def unit_check(*, n_films, groove_depth, angle_ratio, first_film, value=0.1):
 
 
 def run(out_dir, scene=None):
-    """Run the Liao analysis on a scene (default: built-in ``liao2021``), write its CSV files (its figures: :mod:`clutchocp.analyses.figures`).
+    """Run the Liao analysis on a scene (default: built-in ``liao2021``), write its CSV files.
+
+    Its figures are drawn from the result by :mod:`clutchocp.analyses.figures`.
 
     Returns
     -------

@@ -6,7 +6,7 @@ is left that looks complete (results are written through :func:`clutchocp.output
 
 Helpers for the commands' options (:func:`positive_float`, :func:`tolerance`, :func:`count`) are
 argparse ``type=`` functions: a bad value ends in one line naming the option and what is allowed.
-The commands themselves are the functions of :mod:`clutchocp.commands` named like them.
+The commands are the functions of :mod:`clutchocp.commands` named like them; ``scenes`` is here.
 """
 
 import argparse
@@ -17,6 +17,8 @@ import warnings
 
 from . import interrupt
 from .errors import ClutchocpError
+from .scene import list_scenes, load_scene
+from .scene.uncertainty import Uncertainty
 
 # Integration tolerances a user may ask for: tighter than 1e-14 is below double precision noise on
 # the scaled states; looser ones give results that only look like answers (bao2020 at rtol = atol:
@@ -95,6 +97,43 @@ def temperature(text):
     return value
 
 
+def _command(name):
+    """The command ``name`` of :mod:`clutchocp.commands`, imported when it runs."""
+    def run(args):
+        # imported here: --help, scenes and a mistyped option answer without loading the models
+        from . import commands
+        return getattr(commands, name)(args)
+    return run
+
+
+def _cmd_scenes(args):
+    if args.scene:
+        for name in args.scene:
+            _describe(load_scene(name))
+        return 0
+    scenes = list_scenes()
+    width = max(len(s.name) for s in scenes)
+    for scene in scenes:
+        mark = " (default)" if scene.value("scene.default") else ""
+        print(f"{scene.name:<{width}}  {scene.kind:<10}  {scene.title}{mark}")
+    return 0
+
+
+def _describe(scene):
+    """Print a checked scene: its parts, their chosen variants and its uncertain fields."""
+    uncertainty = Uncertainty.from_scene(scene)
+    print(f"{scene.name}: {scene.kind} scene, valid")
+    print(f"  source: {scene.source}")
+    for part in scene.parts:
+        if part != "scene":
+            variant = scene.variant(part)
+            print(f"  [{part}]" + (f" model = {variant}" if variant else ""))
+    if uncertainty:
+        print("  [uncertainty]")
+        for line in uncertainty.describe():
+            print(f"    {line}")
+
+
 def build_parser():
     """The argument parser of the ``clutchocp`` command."""
     parser = _Parser(
@@ -113,8 +152,10 @@ def _add_scene_commands(sub):
     """scenes, validate, simulate, cycles."""
     p = sub.add_parser("scenes", help="list the built-in scenes, one line each; or check the scenes named")
     p.add_argument("scene", nargs="*", help="scene name or TOML file to check and describe")
+    p.set_defaults(run=_cmd_scenes)
     p = sub.add_parser("validate", help="static analyses against the seed papers' tables (Chen, Cui, Liao)")
     p.add_argument("--out", default="out/validate", help="output folder (default: out/validate)")
+    p.set_defaults(run=_command("validate"))
     p = sub.add_parser("simulate", help="simulate an engagement scene through impact and lock-up (IDAS)")
     p.add_argument("scene", help="scene name (see 'clutchocp scenes') or TOML file")
     p.add_argument("--out", default="out/simulate", help="output folder (default: out/simulate); written when complete")
@@ -128,6 +169,7 @@ def _add_scene_commands(sub):
                    help="integrator (default: idas)")
     p.add_argument("--native", action="store_true",
                    help="compile the equations to C with the system compiler first (faster repeated runs)")
+    p.set_defaults(run=_command("simulate"))
     p = sub.add_parser("cycles", help="repeated engagements with cooling between: temperature and engagement-time "
                                       "drift per cycle, until a limit (scene needs a [thermal] part)")
     p.add_argument("scene", help="engagement scene with a [thermal] part (e.g. default_driveline_thermal) or TOML file")
@@ -139,6 +181,8 @@ def _add_scene_commands(sub):
     p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
                    help="override a scene value (repeatable)")
     p.add_argument("--out", default="out/cycles", help="output folder (default: out/cycles)")
+
+    p.set_defaults(run=_command("cycles"))
 
 
 def _add_optimize(sub):
@@ -172,16 +216,20 @@ def _add_optimize(sub):
                    help="after lock-up, ramp to the clamp pressure whose static torque capacity is RATIO x "
                         "the locked torque (>= 1, default: 1.3)")
 
+    p.set_defaults(run=_command("optimize"))
+
 
 def _add_control_commands(sub):
     """bench, control, robust."""
     p = sub.add_parser("bench", help="error against run time, stiffness and scaling (work-precision report)")
     p.add_argument("--quick", action="store_true", help="fewer tolerances, repeats and sizes, no native code (a few minutes)")
     p.add_argument("--out", default="out/bench", help="output folder (default: out/bench)")
+    p.set_defaults(run=_command("bench"))
     p = sub.add_parser("control", help="hydro-viscous drive: operating points, linearisation, speed controller, closed loop")
     p.add_argument("scene", help="an hvd scene (e.g. liao2021_hvd, cui2019_hvd) or TOML file")
     p.add_argument("--controller", default=None, help="controller spec name (lqi, pi) or TOML file (default: lqi)")
     p.add_argument("--out", default="out/control", help="output folder (default: out/control)")
+    p.set_defaults(run=_command("control"))
     p = sub.add_parser("robust", help="Monte Carlo of shift-control strategies over the scene's uncertainty "
                                       "(baseline, nominal optimum, robust feedforward, slip feedback)")
     p.add_argument("scene", nargs="?", default=None, help="engagement scene (default: the default scene)")
@@ -197,6 +245,8 @@ def _add_control_commands(sub):
     p.add_argument("--workers", type=count(1, 1024, "parallel processes"), default=None,
                    help="parallel processes (default: the local cores)")
     p.add_argument("--intervals", type=count(2, MAX_INTERVALS, "collocation intervals"), default=60, help="collocation intervals of the optimisations (default: 60)")
+
+    p.set_defaults(run=_command("robust"))
 
 
 def _add_sweep(sub):
@@ -241,6 +291,7 @@ def _add_sweep(sub):
                    help="optimize: collocation points per interval (default: 3)")
     p.add_argument("--cold", action="store_true", help="optimize: no warm start from the neighbouring point")
     p.add_argument("--no-verify", action="store_true", help="optimize: skip the IDAS replay of each optimum")
+    p.set_defaults(run=_command("sweep"))
 
 
 def main(argv=None):
@@ -258,10 +309,8 @@ def main(argv=None):
                 f"{name}: warning: {' '.join(str(message).split())}", file=sys.stderr)
             args = build_parser().parse_args(argv)
             name = f"clutchocp {args.command}"
-            # imported here: --help and a mistyped option answer without loading the models (0.3 s)
-            from . import commands
             try:
-                code = getattr(commands, args.command)(args)
+                code = args.run(args)
             except ClutchocpError:
                 interrupt.check()          # a solver failure that a Ctrl-C caused is an interrupt
                 raise

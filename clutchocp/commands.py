@@ -1,8 +1,9 @@
 """The commands of ``clutchocp``: each takes the parsed arguments and returns the exit code.
 
-:mod:`clutchocp.cli` parses the command line and runs the function named as the command here;
-it imports this module only when a command runs, so that ``--help`` and a mistyped option answer
-without loading the models, the integrators and the optimiser.
+:mod:`clutchocp.cli` parses the command line and runs the function named as the command here
+(``clutchocp scenes`` excepted, which needs the scene files alone); it imports this module only
+when such a command runs, so that ``--help``, ``scenes`` and a mistyped option answer without
+loading the models, the integrators and the optimiser.
 """
 
 import math
@@ -23,8 +24,7 @@ from .errors import OptionError
 from .optimal.problem import check_weights
 from .optimal.report import run_optimize
 from .output import output_folder
-from .scene import default_scene, list_scenes, load_scene, parse_override
-from .scene.uncertainty import Uncertainty
+from .scene import default_scene, load_scene, parse_override
 from .study import run_sweep
 
 MAX_SWEEP_POINTS = 50     # engagement-time limits in one sweep (each is a full IPOPT solve)
@@ -76,35 +76,6 @@ def parse_weights(text, option="--weights"):
     if not weights:
         raise OptionError(usage)
     return weights
-
-
-def scenes(args):
-    """``clutchocp scenes [SCENE ...]``: list the built-in scenes, or check and describe the ones named."""
-    if args.scene:
-        for name in args.scene:
-            describe(load_scene(name))
-        return 0
-    found = list_scenes()
-    width = max(len(s.name) for s in found)
-    for scene in found:
-        mark = " (default)" if scene.value("scene.default") else ""
-        print(f"{scene.name:<{width}}  {scene.kind:<10}  {scene.title}{mark}")
-    return 0
-
-
-def describe(scene):
-    """Print a checked scene: its parts, their chosen variants and its uncertain fields."""
-    uncertainty = Uncertainty.from_scene(scene)
-    print(f"{scene.name}: {scene.kind} scene, valid")
-    print(f"  source: {scene.source}")
-    for part in scene.parts:
-        if part != "scene":
-            variant = scene.variant(part)
-            print(f"  [{part}]" + (f" model = {variant}" if variant else ""))
-    if uncertainty:
-        print("  [uncertainty]")
-        for line in uncertainty.describe():
-            print(f"    {line}")
 
 
 def validate(args):

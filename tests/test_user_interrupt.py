@@ -126,13 +126,13 @@ def test_without_ctrl_c_the_solvers_run_as_before():
 
 
 def test_a_solver_failure_caused_by_ctrl_c_is_reported_as_the_interrupt(monkeypatch, capsys):
-    from clutchocp import cli, commands
+    from clutchocp import cli
     from clutchocp.errors import SolverError
 
     def failing(args):
         interrupt._state["requested"] = True         # Ctrl-C inside a solver that turned it into a failure
         raise SolverError("rootfinder failed")
-    monkeypatch.setattr(commands, "scenes", failing)
+    monkeypatch.setattr(cli, "_cmd_scenes", failing)
     assert cli.main(["scenes"]) == 130
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "interrupted by the user" in err[0] and "rootfinder" not in err[0]

@@ -34,6 +34,19 @@ def test_time_at_error_uses_the_pareto_front():
     assert wp.time_at_error(points, 1e-4) == pytest.approx(math.sqrt(2.0), rel=1e-12)   # log-midpoint of 2 and 1
 
 
+def test_a_loose_run_slower_than_a_tight_one_leaves_the_levels_between_them_reached():
+    # a two-tolerance sweep whose loose run was timed slower than its tight one (a busy machine):
+    # the tight run is the cheapest at least as accurate at every level up to the loose run's error
+    points = [(1e-8, 2.0), (1e-5, 3.0)]
+    assert wp.pareto_front(points) == [(1e-8, 2.0)]
+    assert wp.time_at_error(points, 1e-6) == 2.0 and wp.time_at_error(points, 1e-5) == 2.0
+    assert wp.time_at_error(points, 1e-9) is None and wp.time_at_error(points, 1e-4) is None
+    rows = [{"method": m, "status": "ok", "error": e, "wall_time_s": w}
+            for m, pts in (("idas", [(1e-8, 1.0), (1e-5, 0.5)]), ("Radau", points)) for e, w in pts]
+    ratios = wp.speedups(rows, peers=("Radau",), levels=(1e-6,))["Radau"]
+    assert ratios[1e-6] == pytest.approx(2.0 / 0.5 ** (2 / 3))          # idas: 2/3 of the way in log-log
+
+
 def test_speedups_divide_peer_time_by_idas_time_at_each_level():
     rows = [{"method": m, "status": "ok", "error": e, "wall_time_s": f * e**-0.2}
             for m, f in (("idas", 1.0), ("Radau", 7.0)) for e in (1e-4, 1e-6, 1e-8)]
@@ -128,7 +141,13 @@ def test_progress_goes_to_the_given_stream(capsys):
     bar = Progress(4, stream=stream)
     bar.step("first")
     bar.note("aside")
-    assert stream.getvalue().count("\n") == 2 and "1/4" in stream.getvalue() and "first" in stream.getvalue()
+    bar.close()
+    text = stream.getvalue()
+    lines = text.replace("\r", "\n").splitlines()
+    assert "1/4" in text                                                   # the count of steps done
+    assert [line.split()[-1] for line in lines if "first" in line or "aside" in line] == ["first", "aside"]
+    assert all(line.split()[0].count(":") == 1 for line in lines if "first" in line)      # elapsed mm:ss
+    assert capsys.readouterr().err == ""                                   # nothing beside the stream
     Progress(2, enabled=False).step("silent")
     assert capsys.readouterr().err == ""
 

@@ -7,7 +7,7 @@ import pytest
 
 from clutchocp.hvd import HvdModel, Scenario, design, load_controller, run_control, simulate_closed_loop
 from clutchocp.hvd.closed_loop import make_scenario
-from clutchocp.hvd.report import linear_step
+from clutchocp.hvd.workflow import linear_step
 from clutchocp.scene import load_scene
 from clutchocp.simulation import PiecewiseConstant, SimulationOptions, simulate
 

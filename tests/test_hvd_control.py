@@ -9,7 +9,8 @@ from scipy.linalg import solve_discrete_are
 
 from clutchocp import errors
 from clutchocp.hvd import HvdModel, ScheduledController, design, load_controller, loop_margins, parse_controller
-from clutchocp.hvd.design import _first_order_model, lqi, lqr_gain
+from clutchocp.control.lqr import lqi, lqr_gain
+from clutchocp.hvd.design import _first_order_model
 from clutchocp.scene import load_scene
 
 GOOD = {"controller": {"type": "lqi", "sample_time": "10 ms", "schedule": [0.4, 0.9]},

@@ -9,7 +9,7 @@ from clutchocp.errors import SceneError
 from clutchocp.scene import default_scene
 from clutchocp.shiftcontrol.montecarlo import Strategy, parallel_map, run_sample, strategy_statistics
 from clutchocp.shiftcontrol.report import run_robust
-from clutchocp.uncertainty import Uncertainty
+from clutchocp.scene.uncertainty import Uncertainty
 
 
 T_MAX = 0.3      # [s]; the constant 0.8 MPa command locks the nominal default scene at 0.285 s
@@ -70,7 +70,7 @@ def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch)
     from types import SimpleNamespace
 
     from clutchocp.optimal.problem import EngagementOCP
-    from clutchocp.shiftcontrol import report
+    from clutchocp.shiftcontrol import workflow
     from clutchocp.shiftcontrol.spec import load_slip_spec
 
     scene = default_scene()
@@ -82,14 +82,14 @@ def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch)
         return SimpleNamespace(success=True, command_times=opt.command_times, command=opt.command,
                                scenarios=[opt], stats={"status": "stand-in"})
 
-    monkeypatch.setattr(report, "robust_solver", lambda: (stand_in, lambda scene, corners: [corners[0]]))
+    monkeypatch.setattr(workflow, "robust_solver", lambda: (stand_in, lambda scene, corners: [corners[0]]))
     spec = replace(load_slip_spec(), t_max_fraction=1.0, schedule_field="")
-    strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene),
+    strategies, facts = workflow.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene),
                                                 spec, intervals=30, say=lambda *a: None)
     assert [s.name for s in strategies] == ["baseline", "nominal_optimum", "robust_feedforward", "closed_loop"]
     assert facts["closed_loop"]["feedforward"] == "nominal_optimum"          # feedforward.curve = "nominal"
     spec.feedforward_curve = "robust"
-    strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene),
+    strategies, facts = workflow.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene),
                                                 spec, intervals=30, say=lambda *a: None)
     assert facts["closed_loop"]["feedforward"] == "robust_feedforward"
     assert len(seen["scenarios"]) == 10                      # 2^3 corners, the centre and the diagonal's point
@@ -101,13 +101,13 @@ def test_closed_loop_tracks_a_feedforward_with_a_time_margin_when_asked(monkeypa
     the closed loop tracks an optimum that locks at that fraction of t_max on the nominal clutch."""
     from dataclasses import replace
 
-    from clutchocp.shiftcontrol import report
+    from clutchocp.shiftcontrol import workflow
     from clutchocp.shiftcontrol.spec import load_slip_spec
 
-    monkeypatch.setattr(report, "robust_solver", lambda: None)
+    monkeypatch.setattr(workflow, "robust_solver", lambda: None)
     scene = default_scene()
     spec = replace(load_slip_spec(), t_max_fraction=0.9, schedule_field="")
-    strategies, facts = report.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene), spec,
+    strategies, facts = workflow.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene), spec,
                                                 intervals=30, say=lambda *a: None)
     t_max = facts["t_max_s"]
     assert [s.name for s in strategies] == ["baseline", "nominal_optimum", "closed_loop"]
@@ -124,14 +124,14 @@ def test_closed_loop_is_scheduled_on_the_oil_viscosity(monkeypatch):
     own scene; a clutch between two viscosities gets their designs blended."""
     from dataclasses import replace
 
-    from clutchocp.shiftcontrol import report
+    from clutchocp.shiftcontrol import workflow
     from clutchocp.shiftcontrol.spec import load_slip_spec
 
-    monkeypatch.setattr(report, "robust_solver", lambda: None)
+    monkeypatch.setattr(workflow, "robust_solver", lambda: None)
     scene = default_scene()
     nominal = scene.without_uncertainty()
     spec = replace(load_slip_spec(), schedule_points=3)
-    strategies, facts = report.build_strategies(nominal, Uncertainty.from_scene(scene), spec, intervals=30,
+    strategies, facts = workflow.build_strategies(nominal, Uncertainty.from_scene(scene), spec, intervals=30,
                                                 say=lambda *a: None)
     eta = nominal.value("oil.viscosity")
     schedule = strategies[-1].feedback

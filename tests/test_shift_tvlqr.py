@@ -4,8 +4,7 @@ import numpy as np
 import pytest
 
 from clutchocp.errors import ModelError
-from clutchocp.hvd.design import lqr_gain
-from clutchocp.shiftcontrol.tvlqr import tvlqr
+from clutchocp.control.lqr import lqr_gain, tvlqr
 
 
 def test_scalar_time_varying_riccati_closed_form():

@@ -205,7 +205,7 @@ def test_an_optimize_chain_warm_starts_and_finds_the_cold_optimum(tmp_path):
 
 
 def test_samples_are_the_seeded_draws_of_the_scene_uncertainty(tmp_path):
-    from clutchocp.uncertainty import Uncertainty
+    from clutchocp.scene.uncertainty import Uncertainty
 
     extra = ("actuation.time_constant=uniform 25 %",)
     summary = run_sweep("zhang2021", tmp_path / "s", samples=3, seed=7, uncertain=extra, engine="serial",

@@ -10,7 +10,7 @@ from scipy.stats import norm
 
 from clutchocp import load_scene
 from clutchocp.errors import SceneError
-from clutchocp.uncertainty import NORMAL_TRUNCATION, Uncertainty
+from clutchocp.scene.uncertainty import NORMAL_TRUNCATION, Uncertainty
 
 
 @pytest.fixture(scope="module")

@@ -244,8 +244,9 @@ def test_a_controller_limit_beyond_the_valve_warns_with_the_value():
 
 @pytest.mark.slow
 def test_closed_loop_figure_shows_valve_limits_and_load_steps(monkeypatch, tmp_path):
+    from clutchocp.hvd import figures as hvd_figures
     from clutchocp.hvd import report as hvd_report
-    figures = captured_figures(monkeypatch, hvd_report)
+    figures = captured_figures(monkeypatch, hvd_figures)
     hvd_report.run_control("liao2021_hvd", "pi", out_dir=tmp_path / "ctl", verbose=False)
     texts = legend_texts(figures["closed_loop.png"])
     assert any("valve limits" in t for t in texts) and any("load steps" in t for t in texts)

@@ -66,7 +66,7 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
         No native-code IDAS, single timed runs (three for the engine methods), coarser
         optimisation meshes.
     progress : bool
-        One line per step on stderr.
+        A progress bar and one line per step on stderr.
     scenes : sequence of Scene, optional
         Default: every built-in engagement scene.
 
@@ -123,6 +123,7 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
     files.append(write_summary(out / "summary.json", json_ready(summary)))
     summary["files"] = [shown(f) for f in files]
     bar.note(f"done in {summary['wall_time_s']:.0f} s; wrote {len(files)} files to {shown(out)}")
+    bar.close()
     return summary
 
 

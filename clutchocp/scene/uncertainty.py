@@ -23,8 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ParameterTypeError, PhysicalRangeError, SceneError, UnknownKeyError
-from .units import to_si
+from ..errors import ParameterTypeError, PhysicalRangeError, SceneError, UnknownKeyError
+from ..units import to_si
+from .fields import parse_field
+from .schema import PARTS
 
 KINDS = ("uniform", "normal")
 NORMAL_TRUNCATION = 3.0   # normal draws are truncated at +- 3 sigma (so every draw is a valid scene)
@@ -225,8 +227,6 @@ def parse_uncertain(text):
 
 def parse_spread(key, spec, scene):
     """One :class:`Spread` from a field name and its spec (as written in the scene or on the CLI)."""
-    from .scene.schema import PARTS
-
     where = f"uncertainty.{key}"
     part, dot, field_name = key.partition(".")
     if not dot or part not in PARTS:
@@ -264,8 +264,6 @@ def parse_spread(key, spec, scene):
 
 
 def _values_spread(key, spec, field, nominal):
-    from .scene.loader import parse_field
-
     where = f"uncertainty.{key}"
     if len(spec) < 2:
         raise ParameterTypeError(f"{where}: give at least two values in the list")

@@ -27,7 +27,7 @@ again from the last solution (a coarse presolve on 10 command steps finds the in
 the fine grid needs few such re-solves). The first lock-up intervals are those of each scenario's
 IDAS replay of the nominal optimum (:meth:`RobustOCP.start_runs`). With one scenario that locks at t_max (the jerk optimum
 uses all the time it may) the mesh is the nominal problem's and so is the optimum (checked in
-tests/test_optimal_robust.py).
+tests/optimal/test_optimal_robust.py).
 
 Lock-up torque jump: each scenario may meet the nominal jump condition (``jump="constraint"``, the
 default of :class:`~clutchocp.optimal.problem.EngagementOCP`), but one command can rarely make

@@ -20,7 +20,7 @@ from clutchocp.study import run_sweep
 from clutchocp.study.folder import CALIBRATION, LOCK, RESULTS, parse_cell
 from clutchocp.study.tasks import SIMULATE_COLUMNS, SIMULATE_RESULTS
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 GRID_2x2 = ["actuation.pressure=0.3 MPa:0.6 MPa:2", "oil.viscosity=0.04:0.06:2"]
 
 

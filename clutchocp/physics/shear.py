@@ -1,17 +1,35 @@
 """Viscous shear torque of the oil film between rough plates (Patir–Cheng shear factors).
 
-Cui 2019 Eq. 5-9: the average shear stress tau = eta (w1 - w2) r (phi_f - phi_fs) / h_T with
-the Patir & Cheng (1979) shear stress factors phi_f (Eq. 6) and phi_fs (Eq. 7-8), integrated
-over the land area of the annulus; Liao 2021 Eq. 2 for plates with radial grooves.
+Cui 2019 Eq. 5-9: the average shear stress of the sliding film with the Patir & Cheng (1979) shear
+stress factors phi_f (Eq. 6) and phi_fs (Eq. 7-8), integrated over the land area of the annulus;
+Liao 2021 Eq. 2 for plates with radial grooves.
+
+Two corrections to Cui Eq. 5 and 9 as printed (derivations in docs/physics.md, tests in
+tests/physics/test_shear.py):
+
+* **Which wall, which sign.** Patir-Cheng's mean stress eta U (phi_f -+ phi_fs) / h is the *viscous*
+  shear on one wall. The torque the film transmits is the same on both plates (the film's momentum
+  balance); on a rough wall it is the viscous shear plus the form drag of the pressure on its
+  asperity flanks, on a smooth wall the viscous shear alone. Patir-Cheng's phi_fs lowers the rough
+  wall's viscous shear by the form drag and raises the smooth wall's by as much, so a rough lining on
+  smooth steel transmits (phi_f + Phi_fs): the transmitted factor is phi_f + |V_r1 - V_r2| Phi_fs
+  (:func:`transmitted_shear_factor`). Zhang 2021 labels the separator w1 and the disc w2, so his
+  phi_f - phi_fs with V_r1 = 0, V_r2 = 1 is the same plus sign; Cui's phi_f - phi_fs with his rougher
+  friction plate as surface 1 is the viscous shear on that plate, not the transmitted stress.
+* **h, not h_T, under phi_f.** phi_f is Patir-Cheng's E[h / h_loc], the mean of the local Couette
+  stress eta U / h_loc written over the *nominal* film h (for H > 3, Cui Eq. 6 is exactly the
+  quadrature of H / (H - s) over Patir's height density 35/32 (1 - s^2)^3, s in units of 3 sigma;
+  phi_f -> 1 + 1/H^2 = h E[1/(h - delta)] for large H). Dividing by the average gap h_T (Cui Eq. 5, 9
+  as printed) counts the roughness twice: h_T = 1.083 h at H = 1.
 
 Units: SI throughout (m, Pa s, rad/s, N m).
 """
 
 import numpy as np
 
-from clutchocp.physics.backend import (exp, fmax, fmin, if_else, is_symbolic, log, softplus,
+from clutchocp.physics.backend import (exp, fabs, fmax, fmin, if_else, is_symbolic, log, softplus,
                                        smooth_step)
-from clutchocp.physics.roughness import average_gap, combined_sigma
+from clutchocp.physics.roughness import combined_sigma
 
 EPS_STAR = 1.0 / 300.0          # Cui 2019 after Eq. 6: eps* = 0.00333 (cut-off film / 3 sigma)
 
@@ -33,10 +51,15 @@ _SERIES = [105.0 / ((2 * m + 1) * (2 * m + 3) * (2 * m + 5) * (2 * m + 7))
 _Z_SERIES = 2.0
 
 
+def _phi_f_thin_per_z(z, eps):
+    """Cui Eq. 6, H <= 3 branch divided by z = H/3 (finite at z = 0)."""
+    poly = -55 + z * (132 + z * (345 + z * (-160 + z * (-405 + z * (60 + 147 * z)))))
+    return 35.0 / 32.0 * ((1 - z * z) ** 3 * log((z + 1) / eps) + poly / 60.0)
+
+
 def _phi_f_thin(z, eps):
     """Cui Eq. 6, H <= 3 branch (z = H/3 in [0, 1])."""
-    poly = -55 + z * (132 + z * (345 + z * (-160 + z * (-405 + z * (60 + 147 * z)))))
-    return 35.0 / 32.0 * z * ((1 - z * z) ** 3 * log((z + 1) / eps) + poly / 60.0)
+    return z * _phi_f_thin_per_z(z, eps)
 
 
 def _phi_f_thick(z):
@@ -94,6 +117,22 @@ def shear_factor_phi_f(H, eps=EPS_STAR, smooth=False, width=0.05):
     return if_else(z <= 1.0, thin, if_else(z <= _Z_SERIES, thick, far))
 
 
+def _phi_f_per_H(H, smooth, width=0.05):
+    """phi_f / H [-], finite at H = 0: the mean Couette stress is eta U (phi_f / H) / sigma.
+
+    For H <= 0 (exact form) it keeps its value at H = 0, (35/96)(ln(1/eps*) - 11/12) = 1.7448:
+    Patir-Cheng's E[sigma / h_loc] over the area still wetted, continued flat past the model's edge
+    (no jump; the real value falls to 0 at H = -3, where the contact area multiplies it by ~0).
+    The smooth form uses softplus(H) for max(H, 0) as :func:`shear_factor_phi_f` does.
+    """
+    Hp = softplus(H, width) if smooth else fmax(H, 0.0)
+    z = Hp / 3.0
+    thin = _phi_f_thin_per_z(fmin(z, 1.5), EPS_STAR) / 3.0
+    thick = _phi_f_thick(fmin(fmax(z, 0.5), 3.0)) / fmax(Hp, 1.5)       # selected for Hp > 3
+    far = _phi_f_far(fmax(z, 1.5)) / fmax(Hp, 4.5)                       # selected for Hp > 6
+    return if_else(z <= 1.0, thin, if_else(z <= _Z_SERIES, thick, far))
+
+
 def _variance_ratio_difference(sigma_1, sigma_2):
     """V_r1 - V_r2 = (sigma_1^2 - sigma_2^2) / sigma^2 (Cui Eq. 7)."""
     return (sigma_1**2 - sigma_2**2) / (sigma_1**2 + sigma_2**2)
@@ -104,6 +143,23 @@ def _both_zero(sigma_1, sigma_2):
             and np.all(np.asarray(sigma_1) == 0) and np.all(np.asarray(sigma_2) == 0))
 
 
+def _Phi_fs(H, smooth, width, power=ALPHA4):
+    """Patir-Cheng's unsigned Phi_fs(H) >= 0 (Cui Eq. 8), exact or smoothly cut off at H = 7.
+
+    ``power = ALPHA4 - 1`` gives Phi_fs / H (0 for H <= 0).
+    """
+    Hp = fmax(H, 0.0)
+    if smooth:
+        Hc = 9.0 - softplus(9.0 - Hp, 0.1)            # ~ min(H, 9): keeps exp(a6 H^2) finite
+        cut = 1.0 - smooth_step(Hp - H_CUT_FS, width)
+    else:
+        Hc = fmin(Hp, H_CUT_FS)                       # finite in the unselected branch
+        cut = if_else(Hp <= H_CUT_FS, 1.0, 0.0)
+    # the base of H^a4 is capped at 10 only to avoid overflow for huge H, where cut is 0
+    # (exact) or below exp(-60) (smooth), so the cap changes nothing visible
+    return A3 * fmin(Hp, 10.0)**power * exp(-ALPHA5 * Hc + ALPHA6 * Hc * Hc) * cut     # Cui Eq. 8
+
+
 def shear_factor_phi_fs(H, sigma_1, sigma_2, smooth=False, width=0.1):
     """Patir–Cheng shear stress factor phi_fs (Cui 2019 Eq. 7-8).
 
@@ -111,6 +167,8 @@ def shear_factor_phi_fs(H, sigma_1, sigma_2, smooth=False, width=0.1):
     Phi_fs = A3 H^a4 exp(-a5 H + a6 H^2) for 0 <= H <= 7 and 0 for H > 7 (A3 = 11.1, a4 = 2.31,
     a5 = 2.38, a6 = 0.11; Patir & Cheng 1979 isotropic). The cut-off at H = 7 is a jump of
     Phi_fs(7) = 0.0127; Phi_fs = 0 for H <= 0. Equal roughness (or both zero) gives phi_fs = 0.
+    The viscous shear on surface 1 is eta U (phi_f - phi_fs) / h, on surface 2 eta U (phi_f + phi_fs)
+    / h; the transmitted torque is :func:`transmitted_shear_factor`.
 
     Parameters
     ----------
@@ -132,27 +190,57 @@ def shear_factor_phi_fs(H, sigma_1, sigma_2, smooth=False, width=0.1):
     """
     if _both_zero(sigma_1, sigma_2):
         return 0.0 * H
-    Hp = fmax(H, 0.0)
-    if smooth:
-        Hc = 9.0 - softplus(9.0 - Hp, 0.1)            # ~ min(H, 9): keeps exp(a6 H^2) finite
-        cut = 1.0 - smooth_step(Hp - H_CUT_FS, width)
-    else:
-        Hc = fmin(Hp, H_CUT_FS)                       # finite in the unselected branch
-        cut = if_else(Hp <= H_CUT_FS, 1.0, 0.0)
-    # the base of H^a4 is capped at 10 only to avoid overflow for huge H, where cut is 0
-    # (exact) or below exp(-60) (smooth), so the cap changes nothing visible
-    Phi_fs = A3 * fmin(Hp, 10.0)**ALPHA4 * exp(-ALPHA5 * Hc + ALPHA6 * Hc * Hc)   # Cui Eq. 8
-    return _variance_ratio_difference(sigma_1, sigma_2) * Phi_fs * cut           # Cui Eq. 7
+    return _variance_ratio_difference(sigma_1, sigma_2) * _Phi_fs(H, smooth, width)      # Cui Eq. 7
+
+
+def transmitted_shear_factor(H, sigma_1, sigma_2, smooth=False, smooth_cutoff=False, width=0.1):
+    """Shear factor of the torque the film transmits: phi_f + |V_r1 - V_r2| Phi_fs [-].
+
+    The film's momentum balance makes the transmitted stress the same on both plates: the viscous
+    shear plus the pressure's form drag on the asperity flanks of a rough wall, the viscous shear
+    alone on a smooth wall. Patir-Cheng's phi_fs lowers the rougher wall's viscous shear by the form
+    drag and raises the smoother wall's by as much, so with one smooth wall the transmitted factor is
+    phi_f + |V_r1 - V_r2| Phi_fs exactly (a rough lining on smooth steel: phi_f + Phi_fs). With two
+    rough walls it is the smoother wall's viscous shear, a lower bound of the transmitted stress (its
+    own form drag is not in Patir-Cheng's factors); with equal roughness phi_fs = 0 and it is phi_f.
+
+    Parameters
+    ----------
+    H : float, array or CasADi symbol
+        Film thickness ratio h / sigma [-].
+    sigma_1, sigma_2 : float or symbol
+        RMS roughness of the two surfaces [m] (the order does not matter).
+    smooth : bool
+        Smooth forms of phi_f and of the cut-off of Phi_fs (:func:`shear_factor_phi_f`,
+        :func:`shear_factor_phi_fs`).
+    smooth_cutoff : bool
+        The smooth cut-off of Phi_fs even with ``smooth=False``.
+    width : float
+        Width of the smooth cut-off of Phi_fs [-].
+
+    Returns
+    -------
+    factor : same type as H
+        Transmitted shear factor [-]; the mean transmitted stress is eta U factor / h (nominal h).
+    """
+    phi_f = shear_factor_phi_f(H, smooth=smooth)
+    if _both_zero(sigma_1, sigma_2):
+        return phi_f
+    asymmetry = fabs(_variance_ratio_difference(sigma_1, sigma_2))                       # |V_r1 - V_r2|
+    return phi_f + asymmetry * _Phi_fs(H, smooth or smooth_cutoff, width)
 
 
 def viscous_torque(w_rel, h, eta, r1, r2, *, sigma_1=0.0, sigma_2=0.0, area_ratio=0.0,
                    land_fraction=1.0, smooth=False, smooth_cutoff=False):
-    """Viscous shear torque of one film between rough annular plates (Cui 2019 Eq. 9).
+    """Viscous torque the film between rough annular plates transmits (Cui 2019 Eq. 9, corrected).
 
-    T = (1 - A_c/A_n) psi (phi_f - phi_fs) pi eta w_rel (r2^4 - r1^4) / (2 h_T), with H = h/sigma,
-    sigma = sqrt(sigma_1^2 + sigma_2^2) and h_T = h Phi(H) + sigma phi(H) the average gap.
-    With sigma_1 = sigma_2 = 0 (numbers) it is the Newtonian torque pi eta w (r2^4 - r1^4)/(2h).
-    Bao 2020 Eq. 25 writes phi_f + phi_fs and h instead of h_T; this follows Cui.
+    T = (1 - A_c/A_n) psi (phi_f + |V_r1 - V_r2| Phi_fs) pi eta w_rel (r2^4 - r1^4) / (2 h), with
+    H = h/sigma, sigma = sqrt(sigma_1^2 + sigma_2^2) and h the nominal film (the distance of the mean
+    planes). The factor over h is evaluated as (factor / H) / sigma, finite at H = 0; below H = 0
+    (the model's edge: the mean planes cross) it keeps its value at H = 0. Cui Eq. 9 as printed has phi_f - phi_fs (the viscous shear on his surface 1, the rougher
+    friction plate) and the average gap h_T; see the module docstring for both corrections. Bao 2020
+    Eq. 25 writes phi_f + phi_fs and h, as here. With sigma_1 = sigma_2 = 0 (numbers) it is the
+    Newtonian torque pi eta w (r2^4 - r1^4)/(2h).
 
     Parameters
     ----------
@@ -185,15 +273,17 @@ def viscous_torque(w_rel, h, eta, r1, r2, *, sigma_1=0.0, sigma_2=0.0, area_rati
         Viscous torque [N m], same sign as w_rel.
     """
     if _both_zero(sigma_1, sigma_2):
-        factor, h_T = 1.0, h
+        per_film = 1.0 / h                                                   # Newtonian: 1 / h
     else:
+        # factor / h = (factor / H) / sigma, written so that it stays finite at H = 0
         sigma = combined_sigma(sigma_1, sigma_2)
         H = h / sigma
-        factor = (shear_factor_phi_f(H, smooth=smooth)
-                  - shear_factor_phi_fs(H, sigma_1, sigma_2, smooth=smooth or smooth_cutoff))
-        h_T = average_gap(h, sigma)                                    # Bao Eq. 10
-    # Cui 2019 Eq. 9
-    return (1.0 - area_ratio) * land_fraction * factor * np.pi * eta * w_rel * (r2**4 - r1**4) / (2.0 * h_T)
+        asymmetry = fabs(_variance_ratio_difference(sigma_1, sigma_2))      # |V_r1 - V_r2|
+        per_H = (_phi_f_per_H(H, smooth)
+                 + asymmetry * _Phi_fs(H, smooth or smooth_cutoff, 0.1, power=ALPHA4 - 1.0))
+        per_film = per_H / sigma
+    # Cui 2019 Eq. 9 with the transmitted factor over the nominal film h
+    return (1.0 - area_ratio) * land_fraction * np.pi * eta * w_rel * (r2**4 - r1**4) / 2.0 * per_film
 
 
 def grooved_viscous_torque(w_rel, h, eta, r1, r2, groove_depth, angle_ratio, n_films=1):

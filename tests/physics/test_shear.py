@@ -6,9 +6,8 @@ import numpy as np
 import pytest
 from scipy.integrate import dblquad, quad
 
-from clutchocp.physics.roughness import average_gap
-from clutchocp.physics.shear import (grooved_viscous_torque, shear_factor_phi_f, shear_factor_phi_fs,
-                                     viscous_torque)
+from clutchocp.physics.shear import (EPS_STAR, grooved_viscous_torque, shear_factor_phi_f, shear_factor_phi_fs,
+                                     transmitted_shear_factor, viscous_torque)
 
 R1, R2 = 0.0725, 0.0975          # m
 ETA = 0.03                       # Pa s
@@ -152,19 +151,101 @@ def test_viscous_torque_newtonian_limit():
     assert rough == pytest.approx(np.pi * ETA * W_REL * (R2**4 - R1**4) / (2 * 1.3e-3), rel=2e-6)
 
 
-def test_viscous_torque_equals_quadrature_of_cui_eq5():
+def test_viscous_torque_equals_quadrature_of_the_transmitted_stress():
     h = 2.0e-6
     sigma = np.hypot(S1, S2)
     H = h / sigma
-    tau_factor = (shear_factor_phi_f(H) - shear_factor_phi_fs(H, S1, S2)) / average_gap(h, sigma)
+    # the transmitted stress eta w r (phi_f + |V_r1 - V_r2| Phi_fs) / h over the nominal film h
+    tau_factor = (shear_factor_phi_f(H) + abs(shear_factor_phi_fs(H, S1, S2))) / h
     area_ratio, land = 0.05, 0.8
-    # Cui Eq. 5 stress, integrated over the land area not in contact
     T, _ = dblquad(lambda r, th: ETA * W_REL * r * tau_factor * r * r, 0, 2 * np.pi, R1, R2, epsrel=1e-12)
     T *= (1 - area_ratio) * land
     got = viscous_torque(W_REL, h, ETA, R1, R2, sigma_1=S1, sigma_2=S2, area_ratio=area_ratio,
                          land_fraction=land)
     assert got == pytest.approx(T, rel=1e-10)
     assert viscous_torque(-W_REL, h, ETA, R1, R2, sigma_1=S1, sigma_2=S2) < 0
+
+
+# ------------------------------------------------- which wall, which sign; h or h_T
+
+def _patir_density(u):
+    """Patir's height density over u = s / (3 sigma) in [-1, 1]: (35/32)(1 - u^2)^3."""
+    return 35.0 / 32.0 * (1 - u * u) ** 3
+
+
+@pytest.mark.parametrize("H", [3.2, 4.0, 6.0, 10.0, 40.0])
+def test_phi_f_is_the_mean_of_nominal_over_local_film(H):
+    """phi_f = E[h / h_loc] with h the nominal film (Patir-Cheng): the mean Couette stress is
+    eta U phi_f / h, so the torque divides by h, not by the average gap h_T. For H > 3 no asperity
+    touches and Cui Eq. 6 equals the quadrature to round-off."""
+    z = H / 3
+    mean, _ = quad(lambda u: z / (z - u) * _patir_density(u), -1, 1, epsabs=0, epsrel=1e-13)
+    assert shear_factor_phi_f(H) == pytest.approx(mean, rel=1e-12)
+
+
+@pytest.mark.parametrize("H", [0.3, 1.0, 2.0, 2.9])
+def test_phi_f_thin_branch_is_the_mean_over_the_wetted_area(H):
+    """H <= 3: the same mean over the local films thicker than the cut-off eps* (3 sigma); Cui Eq. 6
+    is its expansion to leading order in eps*, so the two agree within eps*."""
+    z = H / 3
+    mean, _ = quad(lambda u: z / (z - u) * _patir_density(u), -1, z - EPS_STAR, epsabs=1e-14, epsrel=1e-13,
+                   limit=200)
+    assert abs(shear_factor_phi_f(H) - mean) < EPS_STAR
+
+
+def test_transmitted_factor_is_the_smooth_walls_shear():
+    """A rough wall on a smooth one: the transmitted factor is phi_f + Phi_fs whichever surface is rough,
+    the Patir-Cheng viscous shear of the smooth wall (surface 2: phi_f + phi_fs; surface 1:
+    phi_f - phi_fs), and more than the rough wall's viscous shear."""
+    for H in (0.5, 1.0, 2.0, 4.0):
+        rough_1 = shear_factor_phi_fs(H, S1, 0.0)            # > 0: surface 1 rough
+        assert rough_1 > 0
+        plus = shear_factor_phi_f(H) + rough_1
+        assert transmitted_shear_factor(H, S1, 0.0) == pytest.approx(plus, rel=1e-15)
+        assert transmitted_shear_factor(H, 0.0, S1) == pytest.approx(plus, rel=1e-15)
+        assert shear_factor_phi_f(H) + shear_factor_phi_fs(H, S1, 0.0) == pytest.approx(plus, rel=1e-15)  # wall 2
+        assert shear_factor_phi_f(H) - shear_factor_phi_fs(H, 0.0, S1) == pytest.approx(plus, rel=1e-15)  # wall 1
+    # equal roughness: phi_fs = 0, the factor is phi_f
+    assert transmitted_shear_factor(1.0, S1, S1) == pytest.approx(shear_factor_phi_f(1.0), rel=1e-15)
+
+
+@pytest.mark.parametrize("eps", [0.1, 0.3, 0.5])
+def test_one_dimensional_rough_wall_transmits_more_than_couette(eps):
+    """Second method for the sign: a fixed wall h = h0 (1 + eps cos x) under a smooth wall sliding at U,
+    exact per x (Couette-Poiseuille, constant flux, periodic pressure). The drag on the smooth wall
+    equals the rough wall's viscous shear plus the form drag p dh/dx on its flanks (momentum
+    balance), and exceeds the Couette stress eta U E[1/h] by half the form drag: the transmitted
+    stress of a rough wall on a smooth one is raised, as phi_f + Phi_fs says (in units of eta U E[1/h]:
+    1.015 / 1.129 / 1.333 at eps = 0.1 / 0.3 / 0.5)."""
+    x = np.linspace(0, 2 * np.pi, 20001)[:-1]
+    h = 1 + eps * np.cos(x)
+    I1, I2, I3 = (np.mean(h**-k) for k in (1, 2, 3))
+    q = 0.5 * I2 / I3                                      # flux, eta = U = 1
+    p_x = 6 / h**2 - 12 * q / h**3
+    p = np.cumsum(p_x) * (x[1] - x[0])
+    smooth_drag = np.mean(1 / h + 0.5 * h * p_x)
+    rough_viscous = np.mean(1 / h - 0.5 * h * p_x)
+    form_drag = np.mean(-p * np.gradient(h, x))
+    assert smooth_drag == pytest.approx(rough_viscous + form_drag, rel=1e-6)
+    assert smooth_drag > I1 > rough_viscous
+    assert smooth_drag / I1 == pytest.approx({0.1: 1.015, 0.3: 1.129, 0.5: 1.333}[eps], abs=1e-3)
+
+
+def test_viscous_torque_finite_and_continuous_at_zero_film_ratio():
+    """The torque divides phi_f / H by sigma, so it is finite at h = 0 (phi_f ~ H there) and keeps that
+    value past the edge h < 0 (exact form); the smooth form is positive everywhere."""
+    sigma = np.hypot(S1, S2)
+    at_zero = viscous_torque(W_REL, 0.0, ETA, R1, R2, sigma_1=S1, sigma_2=S2)
+    near = viscous_torque(W_REL, 1e-9 * sigma, ETA, R1, R2, sigma_1=S1, sigma_2=S2)
+    assert np.isfinite(at_zero) and at_zero > 0
+    assert near == pytest.approx(at_zero, rel=1e-8)
+    assert viscous_torque(W_REL, -0.5 * sigma, ETA, R1, R2, sigma_1=S1, sigma_2=S2) == pytest.approx(at_zero, rel=1e-15)
+    # (35/96)(ln(1/eps*) - 11/12) pi eta w (r2^4 - r1^4) / (2 sigma)
+    expected = 35 / 96 * (np.log(300) - 11 / 12) * np.pi * ETA * W_REL * (R2**4 - R1**4) / (2 * sigma)
+    assert at_zero == pytest.approx(expected, rel=1e-13)
+    smooth = viscous_torque(W_REL, np.array([-3, -1, 0, 0.5]) * sigma, ETA, R1, R2, sigma_1=S1, sigma_2=S2,
+                            smooth=True)
+    assert np.all(np.isfinite(smooth)) and np.all(smooth > 0)
 
 
 def test_viscous_torque_smooth_close_to_exact():

@@ -11,17 +11,65 @@ How the fluid and the asperities share the load is a model-form choice (``film.l
 * ``"additive"``: the averaged Reynolds pressure is already a mean over the nominal area (Patir and
   Cheng's flow factors account for the asperities), so W = W_fluid + p_c A_n, the form of most
   mixed-lubrication engagement models.
+
+The fluid load cannot pull the plates together with more than the cavitation pressure allows: its
+mean gauge pressure over the area the oil acts on is limited to ``film.cavitation_pressure``
+(:mod:`clutchocp.physics.cavitation`), so W = g(K (-dh/dt) + S_fluid) + C with the smooth limit g,
+applied to the squeeze and centrifugal/inlet terms together; the contact load C is separate.
 """
 
 import math
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
-from ..physics import contact, friction, roughness, shear, squeeze_film
-from ..physics.backend import fmin
+from ..physics import cavitation, contact, friction, roughness, shear, squeeze_film
+from ..physics.backend import softplus
 from ..physics.viscosity import OilViscosity
+
+AREA_RATIO_CAP = 0.99           # largest real-area ratio: 1 % of the area is left to the oil
+_AREA_CAP_WIDTH = 0.01          # width of its smooth corner [-]
+# Limit width for a cavitation pressure near 0: the corner keeps at least 2 % of 0.1 bar x area
+_MIN_LIMIT_PRESSURE = 1e4       # Pa
+
+
+@dataclass
+class FilmLoad:
+    """The axial load law of one film at its state (thickness, speeds): W(v) = g(K v + S) + C.
+
+    v = -dh/dt is the closing speed [m/s]; g the tension limit of
+    :func:`clutchocp.physics.cavitation.tension_limited_load`.
+
+    Attributes
+    ----------
+    K : squeeze coefficient [N s/m] (the fluid's share of the area applied).
+    S : static fluid load (centrifugal and inlet terms) [N].
+    contact : asperity load [N].
+    limit : tension limit L = p_cav x wetted area [N] (<= 0).
+    width : width of the limit's smooth corner [N].
+    wet_area : area the fluid pressure acts on [m^2].
+    """
+
+    K: object
+    S: object
+    contact: object
+    limit: object
+    width: object
+    wet_area: object
+
+    def fluid(self, v):
+        """Fluid load at the closing speed ``v`` [N], its mean pressure limited at the cavitation pressure."""
+        return cavitation.tension_limited_load(self.K * v + self.S, self.limit, self.width)
+
+    def closing_speed(self, fluid):
+        """Closing speed [m/s] at which the film carries the fluid load ``fluid`` [N] (inverse of :meth:`fluid`)."""
+        return (cavitation.tension_limited_load_inverse(fluid, self.limit, self.width) - self.S) / self.K
+
+    def mean_pressure(self, fluid):
+        """Mean gauge pressure [Pa] of the fluid load ``fluid`` [N] over the area the oil acts on."""
+        return fluid / self.wet_area
 
 # Chen 2021 Eq. 5 is singular below 25 kPa and fitted for 0.2-2 MPa; Cui Eq. 18 is fitted for
 # 0.1-1 MPa. Outside, the pressure fed to the law is clamped to the fitted range.
@@ -59,6 +107,9 @@ class FilmLaw:
         self.centrifugal = scene.get("film.centrifugal", False)
         self.inlet_pressure = scene.get("film.inlet_pressure", 0.0)
         self.load_sharing = scene.get("film.load_sharing", "reduced")
+        self.cavitation_pressure = scene.get("film.cavitation_pressure", -1e5)
+        self.limit_width = (cavitation.WIDTH * max(abs(self.cavitation_pressure), _MIN_LIMIT_PRESSURE)
+                            * self.area)
         self.sigma = scene.value("roughness.sigma")
         # Per surface: sigma_1 of the friction plate (lining), sigma_2 of the separator; they set the
         # Patir-Cheng shear factor phi_fs (Cui Eq. 7: V_r1 - V_r2). The pressure flow factor phi_r
@@ -84,10 +135,13 @@ class FilmLaw:
 
     # -- asperities ---------------------------------------------------------------------------
     def area_ratio(self, h):
-        """Real contact area ratio A_c/A_n [-] (0 without contact), at most 0.99.
+        """Real contact area ratio A_c/A_n [-] (0 without contact), below 0.99.
 
         The Greenwood-Tripp and Greenwood-Williamson ratios are not bounded by 1 (with Bao's
-        data the GT ratio passes 1 near H = 0); the cap keeps 1 % of the area for the oil.
+        data the GT ratio passes 1 near H = 0); the cap keeps 1 % of the area for the oil. It is a
+        smooth minimum, ratio - softplus(ratio - 0.99, 0.01) (= 0.99 - softplus(0.99 - ratio, 0.01),
+        written without cancellation for small ratios): C-infinity, at most 0.99, and equal to the
+        ratio within 0.01 exp(-(0.99 - ratio)/0.01) (1e-19 at a ratio of 0.6).
         """
         if self.contact_model == "none":
             return 0.0
@@ -96,7 +150,7 @@ class FilmLaw:
             ratio = contact.greenwood_tripp_area_ratio(H, self.n_a, self.beta, self.sigma, n0=self.n0)
         else:
             ratio = contact.zhang_area_ratio(H, self.n_a, self.beta, self.sigma)
-        return fmin(ratio, 0.99)
+        return ratio - softplus(ratio - AREA_RATIO_CAP, _AREA_CAP_WIDTH)
 
     def contact_force(self, h):
         """Asperity load over the nominal area [N]."""
@@ -117,8 +171,15 @@ class FilmLaw:
         return delta * contact.zhang_contact_pressure(H, self.E, self.n_a, self.beta, self.sigma) * self.area
 
     # -- axial load ---------------------------------------------------------------------------
-    def load_coefficients(self, h, w_in, w_out):
-        """Film load W = K (-dh/dt) + S: fluid (shared as ``film.load_sharing`` says) + asperities.
+    def fluid_share(self, h):
+        """Share of the nominal area the fluid pressure acts on [-] (``film.load_sharing``)."""
+        if self.load_sharing == "reduced":
+            return 1.0 - self.area_ratio(h)      # Bao Eq. 12, Zhang Eq. 8: fluid on A_n - A_c
+        return 1.0                               # fluid on the whole nominal area, plus p_c A_n
+
+    def film_load(self, h, w_in, w_out):
+        """The load law of a film of thickness ``h``: fluid (shared as ``film.load_sharing`` says,
+        tension-limited) + asperities.
 
         Parameters
         ----------
@@ -129,7 +190,7 @@ class FilmLaw:
 
         Returns
         -------
-        (K, S) : squeeze coefficient [N s/m] and static load [N].
+        FilmLoad
         """
         phi_r = 1.0
         if self.flow_factor == "patir_cheng" and self.sigma > 0:
@@ -142,11 +203,28 @@ class FilmLaw:
         # The load is linear in dh_T/dt; dh_T/dt = Phi(H) dh/dt (Bao Eq. 10).
         per_rate = squeeze_film.film_load(h, -1.0, self.eta, self.r1, self.r2, **kw) - static
         gap_rate = roughness.average_gap_derivative(h, self.sigma) if self.sigma > 0 else 1.0
-        if self.load_sharing == "reduced":
-            fluid_share = 1.0 - self.area_ratio(h)      # Bao Eq. 12, Zhang Eq. 8: fluid on A_n - A_c
-        else:
-            fluid_share = 1.0                           # fluid on the whole nominal area, plus p_c A_n
-        return fluid_share * per_rate * gap_rate, fluid_share * static + self.contact_force(h)
+        share = self.fluid_share(h)
+        return FilmLoad(K=share * per_rate * gap_rate, S=share * static, contact=self.contact_force(h),
+                        limit=self.cavitation_pressure * share * self.area, width=self.limit_width,
+                        wet_area=share * self.area)
+
+    def load_coefficients(self, h, w_in, w_out):
+        """The linear (uncavitated) film law W = K (-dh/dt) + S: fluid + asperities.
+
+        Parameters
+        ----------
+        h : float or CasADi symbol
+            Nominal film thickness [m].
+        w_in, w_out : float or CasADi symbol
+            Speeds of the two plates [rad/s] (used by the centrifugal term only).
+
+        Returns
+        -------
+        (K, S) : squeeze coefficient [N s/m] and static load [N] (fluid and asperities); the film
+        follows it while its fluid load stays above the tension limit (:meth:`film_load`).
+        """
+        load = self.film_load(h, w_in, w_out)
+        return load.K, load.S + load.contact
 
     # -- torque -------------------------------------------------------------------------------
     def mu(self, v, p, theta=None):

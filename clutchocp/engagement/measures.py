@@ -164,8 +164,29 @@ def summarize(model, result, wall_time, options, method):
         "solver": {"method": method, **{k: v for k, v in options.as_dict().items() if k != "idas_options"},
                    "statistics": result.stats},
     }
+    summary.update(film_pressure_summary(model, result))
     summary.update(thermal_summary(model, result))
     return summary
+
+
+def film_pressure_summary(model, result):
+    """The lowest mean film pressure of the run (JSON-ready; units in the key names).
+
+    The mean gauge pressure of a film is its fluid load over the area the oil acts on (the
+    ``film_k_mean_pressure_Pa`` columns); the model limits it smoothly at ``film.cavitation_pressure``
+    (:mod:`clutchocp.physics.cavitation`), so a value near that limit says the films were pulled apart.
+    """
+    lowest = None
+    for i in range(model.n):
+        pressure = np.asarray(result[f"film_{i + 1}_mean_pressure_Pa"])
+        k = int(np.argmin(pressure))
+        if lowest is None or pressure[k] < lowest[0]:
+            lowest = (float(pressure[k]), i + 1, k)
+    value, film, k = lowest
+    return {"min_film_pressure_Pa": value, "min_film_pressure_film": film,
+            "min_film_pressure_time_s": float(result.t[k]),
+            "min_film_pressure_fluid_force_N": float(result[f"film_{film}_fluid_force_N"][k]),
+            "film_cavitation_pressure_Pa": model.film.cavitation_pressure}
 
 
 def thermal_summary(model, result):

@@ -103,6 +103,11 @@ class EngagementModel:
         # massless), picked once: each brings its own states, equations, outputs and events.
         self.piston = piston_part(scene, self._pack_area())
         self.pack = pack_part(scene, self.n, self.plate_masses)
+        if self.piston.present and not self.pack.has_masses and scene.has("spline"):
+            # behind a piston a massless pack's films close at speeds summing to the piston's; with spline
+            # friction they carry unequal loads and, once cavitated, that split is implicit in the face force
+            raise ModelError("spline: spline friction is modelled for a massless pack pressed by the pressure "
+                             "directly (no [piston]), or leave out [spline]")
         self.input_inertia = scene.value("driveline.input") == "inertia"
         self.output_inertia = scene.value("driveline.output") == "inertia"
         self.t = ca.SX.sym("t")
@@ -238,7 +243,7 @@ class EngagementModel:
         w_clutch = self.clutch_side_speed(rotation)
         w_rel = w_in - w_clutch
         h = [self.state(f"h_{i + 1}") for i in range(n)]
-        K, S = zip(*(film.load_coefficients(hi, w_in, w_clutch) for hi in h))
+        loads = [film.film_load(hi, w_in, w_clutch) for hi in h]
         direction = {"slip_forward": 1.0, "slip_reverse": -1.0, "locked": 0.0}[rotation]
         # Films that transmit torque: all of them, or only the first (Bao Eq. 26 as printed); the
         # others still carry axial load.
@@ -251,10 +256,11 @@ class EngagementModel:
 
         # Axial dynamics: the piston alone while it travels freely, then the pack it presses
         drive = self.piston.drive(self.state, axial, p, n, self.H0)
-        if axial == "approach":
-            pressing = Pressing([0.0] * n, drive.free_travel(), 0.0, drive.hydraulic_power(0.0, 0.0))
+        if axial == "approach":     # plates at rest: each film carries its static fluid load
+            pressing = Pressing([0.0] * n, drive.free_travel(), 0.0, drive.hydraulic_power(0.0, 0.0),
+                                fluid=[load.fluid(0.0) for load in loads])
         else:
-            pressing = self.pack.press(self.state, drive, K, S, T_film)
+            pressing = self.pack.press(self.state, drive, loads, T_film)
         rate = {name: 0.0 for name in self.state_names}
         rate.update(drive.rates)
         rate.update(pressing.rates)
@@ -264,7 +270,7 @@ class EngagementModel:
             rate["p_valve"] = self.actuation.state_rate(self.t, self.state("p_valve"))
         turning = self._rotation(rotation, T_film, w_in, w_out, w_clutch)
         rate.update(turning.rates)
-        rate.update(self._energy_rates(rotation, h, K, S, pressing, drive, turning, w_in, w_out, w_rel))
+        rate.update(self._energy_rates(rotation, loads, pressing, drive, turning, w_in, w_out, w_rel))
         heat_power = rate["E_slip"] + rate["E_film"]          # released at the friction interfaces
         rate.update(self.thermal.rates(heat_power))
 
@@ -273,7 +279,7 @@ class EngagementModel:
         z_dict = {"w_hub": self.w_hub} if alg else None
         jerk = time_derivative(ca.SX(turning.a_out), x_dict, [rate[name] for name in self.state_names],
                                z=z_dict, alg=alg or None, t=self.t)
-        out = self._outputs(rotation, p, h, K, S, (w_in, w_out, w_clutch), (T_visc, T_cont, capacity),
+        out = self._outputs(rotation, p, h, loads, (w_in, w_out, w_clutch), (T_visc, T_cont, capacity),
                             pressing, drive, turning, rate, heat_power, jerk)
         events = self._events(axial, rotation, direction, w_rel, capacity)
         torque_scale = max(abs(s.value("driveline.input_torque")), 10.0)
@@ -323,13 +329,17 @@ class EngagementModel:
             rates["w_out"] = a_out
         return Turning(T_in, T_load, T_clutch, a_out, alg, shaft_power, T_shaft, rates)
 
-    def _energy_rates(self, rotation, h, K, S, pressing, drive, turning, w_in, w_out, w_rel):
-        """Rates of the energy accumulators (work in = kinetic + stored + dissipated) [W]."""
-        film, dh = self.film, pressing.dh
+    def _energy_rates(self, rotation, loads, pressing, drive, turning, w_in, w_out, w_rel):
+        """Rates of the energy accumulators (work in = kinetic + stored + dissipated) [W].
+
+        The film power is the fluid load the pack carries (tension-limited) times the closing speed:
+        a cavitated film dissipates the work that pulls it open (the model keeps no cavity volume
+        whose refilling would return it), so the balance closes with the limited load.
+        """
+        dh = pressing.dh
         source_power = turning.T_in * w_in if self.input_inertia else turning.T_clutch * w_in
-        film_fluid_power = sum((Ki * (-dhi) + Si - film.contact_force(hi)) * (-dhi)
-                               for Ki, Si, dhi, hi in zip(K, S, dh, h))
-        contact_power = sum(film.contact_force(hi) * (-dhi) for hi, dhi in zip(h, dh))
+        film_fluid_power = sum(f * (-dhi) for f, dhi in zip(pressing.fluid, dh))
+        contact_power = sum(load.contact * (-dhi) for load, dhi in zip(loads, dh))
         return {"E_source": source_power,
                 "E_hydraulic": pressing.hydraulic_power,
                 "E_load": turning.T_load * w_out,
@@ -341,9 +351,9 @@ class EngagementModel:
                 "E_shaft": turning.shaft_power,
                 "E_impact": 0.0}
 
-    def _outputs(self, rotation, p, h, K, S, speeds, torques, pressing, drive, turning, rate, heat_power, jerk):
+    def _outputs(self, rotation, p, h, loads, speeds, torques, pressing, drive, turning, rate, heat_power, jerk):
         """Named outputs of a mode (every column of the time series besides the states)."""
-        film, n, dh = self.film, self.n, pressing.dh
+        n, dh = self.n, pressing.dh
         w_in, w_out, w_clutch = speeds
         T_visc, T_cont, capacity = torques
         T_clutch = turning.T_clutch
@@ -360,11 +370,13 @@ class EngagementModel:
         out["contact_torque_Nm"] = sum(T_cont) if rotation != "locked" else T_clutch
         out["total_torque_Nm"] = T_clutch
         out["static_capacity_Nm"] = capacity
-        out["contact_force_N"] = sum(film.contact_force(hi) for hi in h) / n
+        out["contact_force_N"] = sum(load.contact for load in loads) / n
         for i in range(n):
-            # per film: the oil's share of the film load W = K (-dh/dt) + S (Bao Eq. 12-13) and the
-            # closing speed; int sum(force x speed) dt is E_film, so the CSV alone closes the balance
-            out[f"film_{i + 1}_fluid_force_N"] = K[i] * (-dh[i]) + S[i] - film.contact_force(h[i])
+            # per film: the oil's share of the film load W = g(K (-dh/dt) + S) + C (Bao Eq. 12-13,
+            # tension-limited), its mean gauge pressure over the area the oil acts on, and the closing
+            # speed; int sum(force x speed) dt is E_film, so the CSV alone closes the balance
+            out[f"film_{i + 1}_fluid_force_N"] = pressing.fluid[i]
+            out[f"film_{i + 1}_mean_pressure_Pa"] = loads[i].mean_pressure(pressing.fluid[i])
             out[f"film_{i + 1}_closing_speed_m_s"] = -dh[i]
         out["pack_force_N"] = pressing.face_force
         out.update(drive.outputs())

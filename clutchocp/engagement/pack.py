@@ -1,10 +1,16 @@
 """The plate pack of an engagement: plates with masses, or a massless pack.
 
 ``pack_part(scene, n, plate_masses)`` returns :class:`PlateMasses` for ``pack.model = "masses"`` and
-:class:`MasslessPack` otherwise. Both turn the film load coefficients and the drive of the piston
-part (:mod:`clutchocp.engagement.piston`) into the film rates of one pressing mode
+:class:`MasslessPack` otherwise. Both turn the film load laws
+(:class:`~clutchocp.engagement.films.FilmLoad`) and the drive of the piston part
+(:mod:`clutchocp.engagement.piston`) into the film rates and fluid forces of one pressing mode
 (:meth:`press`), and publish their states, kinetic energy and impact reset the same way, so the
 model builder needs no ``if``. The massless pack has no states: its plates are in force balance.
+
+The film law is tension-limited (:mod:`clutchocp.physics.cavitation`). With plate masses the fluid
+load is an explicit function of the states; a massless pack pressed by a known force inverts the law
+(its residual slope keeps the inverse defined once a film cavitates); a massless pack behind a piston
+takes its closing speeds from the piston's and its face force from the films' loads.
 """
 
 import math
@@ -20,7 +26,7 @@ class Pressing:
     """The axial dynamics of the pack in one mode.
 
     dh : film rates dh_i/dt [m/s]; rates : {state: rate}; face_force : force on the pack face [N];
-    hydraulic_power, spline_power : [W].
+    hydraulic_power, spline_power : [W]; fluid : fluid load of each film [N] (tension-limited).
     """
 
     dh: list
@@ -28,6 +34,7 @@ class Pressing:
     face_force: object
     hydraulic_power: object
     spline_power: object = 0.0
+    fluid: list = None
 
 
 class PlateMasses:
@@ -55,18 +62,20 @@ class PlateMasses:
         """(name, nominal, initial) of the plate velocities v_1 .. v_n [m/s]."""
         return [(f"v_{i + 1}", v_scale, 0.0) for i in range(self.n)]
 
-    def press(self, state, drive, K, S, T_film):
-        """Plate accelerations from the film loads W = K (-dh/dt) + S (Bao Eq. 12-13, 23)."""
+    def press(self, state, drive, loads, T_film):
+        """Plate accelerations from the film loads W = g(K (-dh/dt) + S) + C (Bao Eq. 12-13, 23), each
+        an explicit function of the plate velocities (``loads``: the :class:`FilmLoad` of each film)."""
         n, m = self.n, self.plate_masses
         v = [state(f"v_{i + 1}") for i in range(n)]
         v[0] = drive.first_plate_velocity(v[0])
         v_next = v[1:] + [0.0]
         dh = [vn - vi for vi, vn in zip(v, v_next)]                      # Bao Eq. 13
-        W = [Ki * (-dhi) + Si for Ki, dhi, Si in zip(K, dh, S)]
+        fluid = [load.fluid(-dhi) for load, dhi in zip(loads, dh)]
+        W = [f + load.contact for f, load in zip(fluid, loads)]
         face_force, rates = drive.push_first_plate(W[0], m[0])
         for i in range(1, n):
             rates[f"v_{i + 1}"] = (W[i - 1] - W[i]) / m[i]                   # Bao Eq. 23
-        return Pressing(dh, rates, face_force, drive.hydraulic_power(face_force, v[0]))
+        return Pressing(dh, rates, face_force, drive.hydraulic_power(face_force, v[0]), fluid=fluid)
 
     def kinetic_energy_terms(self, state):
         return [0.5 * self.plate_masses[i] * state(f"v_{i + 1}") ** 2 for i in range(self.n)]
@@ -114,16 +123,16 @@ class MasslessPack:
             deductions.append(deductions[-1] + coeff[k] * (ca.fabs(torques[k - 1]) + ca.fabs(torques[k])))
         return deductions
 
-    def press(self, state, drive, K, S, T_film):
-        """Film rates of the force balance: F_k = F_face - d_k = K_k (-dh_k/dt) + S_k (Bao Eq. 12)."""
+    def press(self, state, drive, loads, T_film):
+        """Film rates of the force balance F_face - d_k = g(K_k (-dh_k/dt) + S_k) + C_k (Bao Eq. 12), d_k
+        the spline friction before film k (``loads``: the :class:`FilmLoad` of each film)."""
         d = self.spline_deductions(T_film)
-        face_force, rates = drive.press_massless(d, S, K)
-        force = [face_force - dk for dk in d]
-        dh = [-(Fk - Sk) / Kk for Fk, Sk, Kk in zip(force, S, K)]
+        face_force, closing, fluid, rates = drive.press_massless(loads, d)
+        dh = [-vk for vk in closing]
         # Work of the face force not passed on to the films is lost in the splines.
-        spline_power = sum((face_force - Fk) * (-dhi) for Fk, dhi in zip(force, dh))
-        hydraulic_power = drive.hydraulic_power(face_force, sum(-dhi for dhi in dh))
-        return Pressing(dh, rates, face_force, hydraulic_power, spline_power)
+        spline_power = sum(dk * vk for dk, vk in zip(d, closing))
+        hydraulic_power = drive.hydraulic_power(face_force, sum(closing))
+        return Pressing(dh, rates, face_force, hydraulic_power, spline_power, fluid=fluid)
 
     def kinetic_energy_terms(self, state):
         return []

@@ -62,9 +62,18 @@ class PressureOnPack:
         (face force [N], {state: rate})."""
         return self.face_force, {"v_1": (self.face_force - W_1) / m_1}
 
-    def press_massless(self, d, S, K):
-        """Force on the face of a massless pack [N] and the rates it sets ({}): the pressure force."""
-        return self.face_force, {}
+    def press_massless(self, loads, d):
+        """A massless pack under the known face force: each film carries it less the spline friction
+        before it, F - d_k = fluid_k + C_k, and closes at the speed its (tension-limited) law gives for
+        that fluid load (:meth:`~clutchocp.engagement.films.FilmLoad.closing_speed`).
+
+        Returns
+        -------
+        (face force [N], closing speeds [m/s], fluid loads [N], {state: rate}: none)
+        """
+        fluid = [self.face_force - dk - load.contact for load, dk in zip(loads, d)]
+        closing = [load.closing_speed(f) for load, f in zip(loads, fluid)]
+        return self.face_force, closing, fluid, {}
 
     def hydraulic_power(self, face_force, face_speed):
         """Work rate of the pressure on the pack face [W]."""
@@ -177,11 +186,28 @@ class PistonDrive:
         rate = front / m_front
         return 0.0, {"v0": rate, "v_1": rate}
 
-    def press_massless(self, d, S, K):
-        """Massless plates: the piston speed fixes the sum of film rates, which sets the force on the
-        pack face: v0 = sum (F_face - d_k - S_k) / K_k. (face force [N], {state: rate})."""
-        face_force = (self.v0 + sum((dk + Sk) / Kk for dk, Sk, Kk in zip(d, S, K))) / sum(1 / Kk for Kk in K)
-        return face_force, {"v0": (self.net_force - face_force) / self.mass}
+    def press_massless(self, loads, d):
+        """Massless plates behind the piston: the piston speed is the sum of the films' closing speeds,
+        and the films' loads set the force on the pack face.
+
+        The closing speeds are split as the linear film law splits them, v_k = (F_lin - C_k - d_k - S_k)
+        / K_k with sum v_k = v0; each film's fluid load is then its tension-limited law at v_k, and the
+        face force the mean of the films' loads, F = mean(fluid_k + C_k + d_k). With equal films (a
+        massless pack behind a piston has no spline friction, and every film starts from the same gap)
+        each closes at v0 / n and this is exact: every film carries F; the piston's mass, not the film,
+        then sets how fast a cavitated pack opens. Films made unequal (``initial_state``) share the
+        closing speed by the linear law, exact while no film cavitates.
+
+        Returns
+        -------
+        (face force [N], closing speeds [m/s], fluid loads [N], {state: rate})
+        """
+        base = [load.contact + dk + load.S for load, dk in zip(loads, d)]
+        F_lin = (self.v0 + sum(b / load.K for b, load in zip(base, loads))) / sum(1 / load.K for load in loads)
+        closing = [(F_lin - b) / load.K for b, load in zip(base, loads)]
+        fluid = [load.fluid(vk) for load, vk in zip(loads, closing)]
+        face_force = sum(f + load.contact + dk for f, load, dk in zip(fluid, loads, d)) / len(loads)
+        return face_force, closing, fluid, {"v0": (self.net_force - face_force) / self.mass}
 
     def hydraulic_power(self, face_force, face_speed):
         """Work rate of the oil on the piston [W] (its sign: the pressure releases a spring-applied piston)."""

@@ -48,6 +48,8 @@ def format_summary(summary):
         f"  torque response (Zhang)     {num('torque_response_time_stable_s', 's')} to 90 % of the stable "
         f"{num('stable_torque_Nm', 'N m')}; {num('torque_response_time_s', 's')} to 90 % of the peak",
         f"  dissipated energy           {num('dissipated_energy_J', 'J')}",
+        f"  lowest mean film pressure   {num('min_film_pressure_Pa', 'Pa')} (film {summary['min_film_pressure_film']} "
+        f"at {summary['min_film_pressure_time_s']:.4g} s; cavitation at {summary['film_cavitation_pressure_Pa']:.4g} Pa)",
         f"  specific energy             {num('specific_energy_J_mm2', 'J/mm^2', '{:.4g}')}",
         f"  peak specific power         {num('peak_specific_power_W_mm2', 'W/mm^2', '{:.4g}')}",
         *([f"  peak interface temperature  {num('peak_interface_temperature_C', 'degC', '{:.1f}')}"]

@@ -24,6 +24,7 @@ CHECKS = {
     "friction": (lambda v: 0 < v < 2, "in (0, 2)"),
     "celsius": (lambda v: v > -273.15, "above absolute zero (> -273.15 degC)"),
     "any": (lambda v: True, "any value"),
+    "cavitation_pressure": (lambda v: -1e6 <= v <= 0, "in [-1e6, 0] Pa (gauge: from -10 bar to ambient)"),
     # Limits that protect the machine and the meaning of a result (see RESOURCE_LIMITS):
     "pressure": (lambda v: 0 <= v <= MAX_PRESSURE, "in [0, 1e8] Pa (100 MPa is above any clutch or valve pressure)"),
     "positive_pressure": (lambda v: 0 < v <= MAX_PRESSURE,
@@ -159,6 +160,13 @@ PARTS = {
                                   default="reduced",
                                   doc="fluid load on the free area (1 - A_c/A_n) W_fluid + p_c A_n (Bao Eq. 12, "
                                       "'reduced') or the full W_fluid + p_c A_n ('additive')"),
+            "cavitation_pressure": QOpt("Pa", -1e5, "cavitation_pressure",
+                                        doc="lowest mean gauge pressure a film holds when its plates are pulled "
+                                            "apart [Pa]; the fluid load is limited smoothly there (the film "
+                                            "cavitates). Default -1 bar: absolute zero at 1 bar ambient, the most "
+                                            "suction any oil film can give (vapour pressure ~0 absolute); dissolved "
+                                            "air comes out above that, so a gaseous cavity holds less (e.g. "
+                                            "-0.3 bar)"),
         },
     ),
     "roughness": Part(

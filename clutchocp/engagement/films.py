@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..physics import cavitation, contact, friction, roughness, shear, squeeze_film
-from ..physics.backend import softplus
+from ..physics.backend import if_else, softplus
 from ..physics.viscosity import OilViscosity
 
 AREA_RATIO_CAP = 0.99           # largest real-area ratio: 1 % of the area is left to the oil
@@ -139,9 +139,10 @@ class FilmLaw:
 
         The Greenwood-Tripp and Greenwood-Williamson ratios are not bounded by 1 (with Bao's
         data the GT ratio passes 1 near H = 0); the cap keeps 1 % of the area for the oil. It is a
-        smooth minimum, ratio - softplus(ratio - 0.99, 0.01) (= 0.99 - softplus(0.99 - ratio, 0.01),
-        written without cancellation for small ratios): C-infinity, at most 0.99, and equal to the
-        ratio within 0.01 exp(-(0.99 - ratio)/0.01) (1e-19 at a ratio of 0.6).
+        smooth minimum, 0.99 - softplus(0.99 - ratio, 0.01) = ratio - softplus(ratio - 0.99, 0.01)
+        (the second form below the cap, free of cancellation for small ratios; the first above it,
+        never above 0.99 in doubles): C-infinity, at most 0.99, and equal to the ratio within
+        0.01 exp(-(0.99 - ratio)/0.01) (1e-19 at a ratio of 0.6).
         """
         if self.contact_model == "none":
             return 0.0
@@ -150,7 +151,8 @@ class FilmLaw:
             ratio = contact.greenwood_tripp_area_ratio(H, self.n_a, self.beta, self.sigma, n0=self.n0)
         else:
             ratio = contact.zhang_area_ratio(H, self.n_a, self.beta, self.sigma)
-        return ratio - softplus(ratio - AREA_RATIO_CAP, _AREA_CAP_WIDTH)
+        return if_else(ratio < AREA_RATIO_CAP, ratio - softplus(ratio - AREA_RATIO_CAP, _AREA_CAP_WIDTH),
+                       AREA_RATIO_CAP - softplus(AREA_RATIO_CAP - ratio, _AREA_CAP_WIDTH))
 
     def contact_force(self, h):
         """Asperity load over the nominal area [N]."""

@@ -377,6 +377,9 @@ class EngagementModel:
             # speed; int sum(force x speed) dt is E_film, so the CSV alone closes the balance
             out[f"film_{i + 1}_fluid_force_N"] = pressing.fluid[i]
             out[f"film_{i + 1}_mean_pressure_Pa"] = loads[i].mean_pressure(pressing.fluid[i])
+            # the mean pressure of the averaged Reynolds film at the same closing speed without the
+            # tension limit: below film.cavitation_pressure the film has cavitated
+            out[f"film_{i + 1}_reynolds_pressure_Pa"] = loads[i].mean_pressure(loads[i].K * (-dh[i]) + loads[i].S)
             out[f"film_{i + 1}_closing_speed_m_s"] = -dh[i]
         out["pack_force_N"] = pressing.face_force
         out.update(drive.outputs())

@@ -25,12 +25,26 @@ def write_engagement(run, out_dir):
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    series = run.series()
-    columns = {name: [str(v) for v in values] if name == "mode" else np.asarray(values, dtype=float)
-               for name, values in series.items()}
-    files = [write_summary(out / "summary.json", run.summary), write_csv(out / "timeseries.csv", columns)]
+    files = [write_summary(out / "summary.json", run.summary), write_timeseries(run, out / "timeseries.csv")]
     files += plot_engagement(run, out)
     return files
+
+
+def write_timeseries(run, path):
+    """Write the time series of an engagement run (:meth:`EngagementResult.series`) as a CSV file.
+
+    Parameters
+    ----------
+    run : clutchocp.engagement.run.EngagementResult
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    columns = {name: [str(v) for v in values] if name == "mode" else np.asarray(values, dtype=float)
+               for name, values in run.series().items()}
+    return write_csv(Path(path), columns)
 
 
 def format_summary(summary):

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..engagement.report import plot_heat
+from ..engagement.report import plot_heat, write_timeseries
 from ..errors import ClutchocpError
 from ..output import shown, write_csv, write_summary, writes_folder
 from ..scene import default_scene, load_scene
@@ -26,7 +26,7 @@ from .verify import holding_pressure, run_numbers, verify
 
 KEYS = ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral", "dissipated_energy_J", "peak_jerk_rad_s3",
         "peak_torque_Nm")
-COMPARE_KEYS = KEYS + ("locked_torque_Nm", "kiss_time_s", "kiss_speed_m_s", "kiss_jerk_rad_s3")
+COMPARE_KEYS = KEYS + ("locked_torque_Nm", "kiss_time_s", "kiss_speed_m_s", "kiss_jerk_rad_s3", "min_film_pressure_Pa")
 # Minimum engagement time (a little command smoothing keeps the command regular).
 FAST_WEIGHTS = {"jerk": 0.0, "time": 1.0, "smooth": 0.01}
 
@@ -45,7 +45,8 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
     scene : clutchocp.scene.Scene, str or pathlib.Path, optional
         Scene, built-in scene name or file (default: the default scene).
     out_dir : str or pathlib.Path
-        Output folder (created): pressure_profile.csv, summary.json, PNG figures.
+        Output folder (created): pressure_profile.csv, timeseries.csv (the IDAS replay of the optimum, the
+        columns of the simulate command), summary.json, PNG figures.
     t_max : float, optional
         Largest engagement time [s] (default: the lock-up time of the scene's own profile;
         ``numpy.inf``: none, then weight the time or the energy).
@@ -81,7 +82,9 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
                             max_specific_power_W_mm2=max_specific_power_W_mm2, clamp_margin=clamp_margin)
     summary, scene, ocp, opt, replay = result.summary, result.scene, result.ocp, result.optimum, result.replay
     out = Path(out_dir)
-    files = [_write_profile(out, result), write_summary(out / "summary.json", summary)]
+    # the IDAS replay of the optimum, with the columns of the simulate command's time series
+    files = [_write_profile(out, result), write_timeseries(replay, out / "timeseries.csv"),
+             write_summary(out / "summary.json", summary)]
     files += plot_optimum(out, scene, opt, replay, ocp.baseline, result.baselines, summary, result.curve,
                           result.clamp_run)
     files.append(plot_heat(replay, out / "heat.png", max_temperature_C=max_temperature_C,
@@ -142,7 +145,8 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
 
     summary = {
         "scene": scene.name,
-        "optimal": {k: opt.terms[k] for k in KEYS + ("slip_jerk_integral",)},
+        "optimal": {k: opt.terms[k] for k in KEYS + ("slip_jerk_integral", "min_film_pressure_Pa")},
+        "film_cavitation_pressure_Pa": ocp.model.film.cavitation_pressure,
         "baseline": dict(run_numbers(ocp.baseline), profile=baseline_label(scene)),
         "baselines": {name: numbers for name, (_, numbers) in baselines.items()},
         "verification": {k: check[k] for k in ("lock_time_rel_diff", "lock_time_resolution_s", "torque_jump_Nm",
@@ -287,7 +291,7 @@ def _sweep(ocp, opt, values, weights, say):
             guess = res
             results[t_max] = {"t_max_s": t_max, "status": res.stats["status"],
                               "iterations": res.stats["iterations"], "wall_time_s": res.stats["wall_time_s"],
-                              **{k: res.terms[k] for k in KEYS + ("slip_jerk_integral",)}}
+                              **{k: res.terms[k] for k in KEYS + ("slip_jerk_integral", "min_film_pressure_Pa")}}
             say(f"  sweep [{done}/{total}] t_max = {t_max:.4g} s: jerk integral {res.terms['jerk_integral']:.4g} "
                 f"rad^2/s^5, energy {res.terms['dissipated_energy_J']:.4g} J ({res.stats['iterations']} iterations, "
                 f"{res.stats['wall_time_s']:.2f} s)")
@@ -317,6 +321,9 @@ def format_summary(summary):
                  f"(rel. diff {_num(ver['lock_time_rel_diff'])}), jump {_num(ver['torque_jump_Nm'])} N m "
                  f"-> {'passed' if ver['passed'] else 'FAILED'}")
     lines.append(f"  jerk integral / kinematic lower bound: {summary['jerk_lower_bound_ratio']:.3g}")
+    lines.append(f"  lowest mean film pressure: {_num(opt['min_film_pressure_Pa'])} Pa (IDAS "
+                 f"{_num(ver['idas']['min_film_pressure_Pa'])} Pa, film {ver['idas']['min_film_pressure_film']}; "
+                 f"cavitation at {summary['film_cavitation_pressure_Pa']:.4g} Pa)")
     heat = summary.get("heat")
     if heat is not None and "peak_interface_temperature_C" in heat["idas"]:
         lines.append(f"  peak interface temperature: {heat['collocation']['peak_interface_temperature_C']:.2f} degC "

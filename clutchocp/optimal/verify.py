@@ -20,6 +20,7 @@ from .replay import simulate_command
 LOCK_TIME_TOLERANCE = 0.01      # relative
 JUMP_TOLERANCE = 0.02           # relative to the torque carried after lock-up (or the peak torque, see above)
 HOLD_DELAY = 1e-3               # the holding command starts at (1 + HOLD_DELAY) t_f
+FILM_PRESSURE_KEYS = ("min_film_pressure_Pa", "min_film_pressure_film", "min_film_pressure_time_s")
 
 
 def run_numbers(run):
@@ -32,14 +33,17 @@ def run_numbers(run):
         lock-up, fill and slip [rad^2/s^5], trapezoidal on the output samples), peak_jerk_rad_s3, peak_torque_Nm,
         dissipated_energy_J (at lock-up), locked_torque_Nm, kiss_time_s and kiss_speed_m_s (the
         impact of the piston on the pack; None without free travel), kiss_jerk_rad_s3 (the jerk just
-        after the kiss, part of the peak jerk). With the output held (a brake)
-        the jerk is the input's, -dT/dt / I_in by differences of the clutch torque.
+        after the kiss, part of the peak jerk), and the lowest mean film pressure of the whole run
+        (min_film_pressure_Pa, its film and time; the film law limits it at film.cavitation_pressure).
+        With the output held (a brake) the jerk is the input's, -dT/dt / I_in by differences of the
+        clutch torque.
     """
     summary = run.summary
     out = {"engagement_time_s": summary["engagement_time_s"], "lockup_torque_jump_Nm": summary["lockup_torque_jump_Nm"],
            "jerk_integral": None, "peak_jerk_rad_s3": None, "peak_torque_Nm": summary["peak_torque_Nm"],
            "dissipated_energy_J": summary["dissipated_energy_J"], "locked_torque_Nm": None,
-           "kiss_time_s": None, "kiss_speed_m_s": None, "kiss_jerk_rad_s3": None}
+           "kiss_time_s": None, "kiss_speed_m_s": None, "kiss_jerk_rad_s3": None,
+           **{k: summary[k] for k in FILM_PRESSURE_KEYS}}
     impact = [e for e in run.result.events if e.name == "impact"]
     if impact:
         out["kiss_time_s"], out["kiss_speed_m_s"] = float(impact[0].t), float(impact[0].x_before["v0"])
@@ -141,6 +145,7 @@ def verify(ocp, opt, *, model=None, rtol=None, atol=None):
                                         "locked_torque_Nm")}
     colloc["kiss_time_s"], colloc["kiss_speed_m_s"] = opt.terms.get("fill_time_s"), opt.terms.get("kiss_speed_m_s")
     colloc["kiss_jerk_rad_s3"] = opt.terms.get("kiss_jerk_rad_s3")
+    colloc["min_film_pressure_Pa"] = opt.terms.get("min_film_pressure_Pa")
     # IDAS locates lock-up to |w_rel| / w_scale <= event_value_tol; at the final slip rate that is:
     w_scale = max(ocp.scene.value("driveline.input_speed"), 1.0)
     rate = abs(opt.outputs["slip_acceleration_rad_s2"][-1])

@@ -140,16 +140,32 @@ def test_pi_loop_is_the_product_of_controller_and_plant(designs):
         np.testing.assert_allclose(p.loop(z), (p.k_p + p.k_i * Ts / (z - 1)) * plant, rtol=1e-9)
 
 
-def test_unequal_films_lqi_is_stable_and_pi_pole_placement_refuses():
-    """Liao's films add slow (one slightly unstable) distribution modes: state feedback handles them,
-    SIMC (which assumes a stable plant) says so in one line."""
-    model = HvdModel(load_scene("liao2021_hvd", overrides={"hvc.friction_ratio": "0.1 1/mm^2",
-                                                           "hvc.first_film": "0.1 mm", "hvd.spline_friction": 0.1}))
+def _unequal_liao_films():
+    return HvdModel(load_scene("liao2021_hvd", overrides={"hvc.friction_ratio": "0.1 1/mm^2",
+                                                          "hvc.first_film": "0.1 mm", "hvd.spline_friction": 0.1}))
+
+
+def test_unequal_films_lqi_is_stable():
+    """Liao's unequal films add slow distribution modes; state feedback handles them with margin."""
+    model = _unequal_liao_films()
     lqi_spec = parse_controller({"controller": {"type": "lqi", "sample_time": 0.01, "schedule": [0.6]},
                                  "lqi": {"speed_weight": 100.0, "integral_weight": 1000.0}})
     sched = design(model, lqi_spec)
-    assert max(np.real(sched.points[0].plant.poles())) > 0            # the open loop has an unstable mode
     assert sched.points[0].margins["stable"] and sched.points[0].margins["gain_margin_dB"] >= 6
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "measured on the transmitted shear factor (phi_f + |V_r1 - V_r2| Phi_fs over the nominal film h): the "
+    "open loop of liao2021_hvd with unequal films at 0.6 x rated speed is stable (slowest pole -0.057 1/s), so "
+    "SIMC pole placement designs a PI instead of refusing; the unstable distribution mode came from the "
+    "viscous shear of the rougher wall (phi_f - phi_fs over h_T)"))
+def test_unequal_films_open_loop_unstable_and_pi_pole_placement_refuses():
+    """Liao's films add one slightly unstable distribution mode: SIMC (which assumes a stable plant) says so
+    in one line."""
+    model = _unequal_liao_films()
+    lqi_spec = parse_controller({"controller": {"type": "lqi", "sample_time": 0.01, "schedule": [0.6]},
+                                 "lqi": {"speed_weight": 100.0, "integral_weight": 1000.0}})
+    assert max(np.real(design(model, lqi_spec).points[0].plant.poles())) > 0
     pi_spec = parse_controller({"controller": {"type": "pi", "sample_time": 0.01, "schedule": [0.6]},
                                 "pi": {"method": "pole_placement"}})
     with pytest.raises(errors.ModelError, match="at 0.6 x rated speed: pi: pole placement"):

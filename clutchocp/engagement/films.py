@@ -31,8 +31,6 @@ from ..physics.viscosity import OilViscosity
 
 AREA_RATIO_CAP = 0.99           # largest real-area ratio: 1 % of the area is left to the oil
 _AREA_CAP_WIDTH = 0.01          # width of its smooth corner [-]
-# Limit width for a cavitation pressure near 0: the corner keeps at least 2 % of 0.1 bar x area
-_MIN_LIMIT_PRESSURE = 1e4       # Pa
 
 
 @dataclass
@@ -108,8 +106,6 @@ class FilmLaw:
         self.inlet_pressure = scene.get("film.inlet_pressure", 0.0)
         self.load_sharing = scene.get("film.load_sharing", "reduced")
         self.cavitation_pressure = scene.get("film.cavitation_pressure", -1e5)
-        self.limit_width = (cavitation.WIDTH * max(abs(self.cavitation_pressure), _MIN_LIMIT_PRESSURE)
-                            * self.area)
         self.sigma = scene.value("roughness.sigma")
         # Per surface: sigma_1 of the friction plate (lining), sigma_2 of the separator; they set the
         # Patir-Cheng shear factor phi_fs (Cui Eq. 7: V_r1 - V_r2). The pressure flow factor phi_r
@@ -206,9 +202,9 @@ class FilmLaw:
         per_rate = squeeze_film.film_load(h, -1.0, self.eta, self.r1, self.r2, **kw) - static
         gap_rate = roughness.average_gap_derivative(h, self.sigma) if self.sigma > 0 else 1.0
         share = self.fluid_share(h)
+        limit = self.cavitation_pressure * share * self.area                  # L = p_cav A_wet < 0
         return FilmLoad(K=share * per_rate * gap_rate, S=share * static, contact=self.contact_force(h),
-                        limit=self.cavitation_pressure * share * self.area, width=self.limit_width,
-                        wet_area=share * self.area)
+                        limit=limit, width=-cavitation.WIDTH * limit, wet_area=share * self.area)
 
     def load_coefficients(self, h, w_in, w_out):
         """The linear (uncavitated) film law W = K (-dh/dt) + S: fluid + asperities.

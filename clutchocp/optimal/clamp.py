@@ -151,13 +151,7 @@ class ClampModel:
         return sol.x
 
     def capacity(self, pressure):
-        """Static capacity [N m] of the settled pack under the command ``pressure`` [Pa]; 0 if the films
-        still open at the open gap (a face force below the load a film at rest carries, the smooth
-        cavitation limit's offset of 1e-4 |p_cav| x its area: no settled pack)."""
-        open_gap = self.x_lock.copy()
-        open_gap[self.films] = self.model.H0
-        if np.array(self._fn(open_gap, pressure)).ravel()[self.n_rates - 1] > 0:
-            return 0.0
+        """Static capacity [N m] of the settled pack under the command ``pressure`` [Pa]."""
         x = self.x_lock.copy()
         x[self.films] = self.settled_films(pressure)
         return float(np.array(self._fn(x, pressure)).ravel()[self.n_rates])

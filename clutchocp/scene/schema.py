@@ -24,7 +24,7 @@ CHECKS = {
     "friction": (lambda v: 0 < v < 2, "in (0, 2)"),
     "celsius": (lambda v: v > -273.15, "above absolute zero (> -273.15 degC)"),
     "any": (lambda v: True, "any value"),
-    "cavitation_pressure": (lambda v: -1e6 <= v <= 0, "in [-1e6, 0] Pa (gauge: from -10 bar to ambient)"),
+    "cavitation_pressure": (lambda v: -1e6 <= v <= -1e3, "in [-1e6, -1e3] Pa (gauge: from -10 bar to -0.01 bar)"),
     # Limits that protect the machine and the meaning of a result (see RESOURCE_LIMITS):
     "pressure": (lambda v: 0 <= v <= MAX_PRESSURE, "in [0, 1e8] Pa (100 MPa is above any clutch or valve pressure)"),
     "positive_pressure": (lambda v: 0 < v <= MAX_PRESSURE,

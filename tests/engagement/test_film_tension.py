@@ -23,7 +23,7 @@ import pytest
 
 from clutchocp.engagement.measures import energy_balance
 from clutchocp.engagement.model import EngagementModel
-from clutchocp.physics.cavitation import RESIDUAL_SLOPE, tension_limited_load_inverse
+from clutchocp.physics.cavitation import RESIDUAL_SLOPE, WIDTH, tension_limited_load_inverse
 from clutchocp.physics.squeeze_film import squeeze_geometry
 from clutchocp.scene import load_scene
 from clutchocp.simulation import SimulationOptions, simulate
@@ -63,7 +63,7 @@ def test_massless_discs_separate_by_the_closed_form(fraction):
     model = _discs()
     film = model.film
     F, L = pressure * film.area, P_CAV * film.area
-    x = float(tension_limited_load_inverse(F, L, film.limit_width))
+    x = float(tension_limited_load_inverse(F, L, WIDTH * abs(L)))
     h0 = model.H0
     c = _squeeze_constant(model)
     t_inf = c / (2 * abs(x) * h0**2)                       # the film would open without bound at t_inf
@@ -112,7 +112,7 @@ def test_cavitation_pressure_sets_the_limit():
     film = model.film
     assert film.cavitation_pressure == 0.5 * P_CAV
     F, L = 2 * P_CAV * film.area, 0.5 * P_CAV * film.area
-    x = float(tension_limited_load_inverse(F, L, film.limit_width))
+    x = float(tension_limited_load_inverse(F, L, WIDTH * abs(L)))
     assert x == pytest.approx(L + (F - L) / RESIDUAL_SLOPE, rel=1e-3)
     c = _squeeze_constant(model)
     _, result = _pull(2 * P_CAV, 0.25 * c / (abs(x) * model.H0**2), points=51, model=model)

@@ -43,8 +43,8 @@ it has no holding condition (a lock that carries nothing always holds). With the
 term is the jerk of the input (the braked inertia), as the output does not move.
 
 Constraints: t_f <= t_max, E <= E_max, films h >= h_min, 0 <= u <= actuation.max_pressure,
-|du/dt| <= rate limit, w_rel >= 0; each film opens no faster than its Reynolds film would at
-3 x film.cavitation_pressure (the film law itself holds its mean pressure at that pressure, see
+|du/dt| <= rate limit, w_rel >= 0; behind a piston each film opens no faster than its Reynolds film
+would at 3 x film.cavitation_pressure (the film law itself holds its mean pressure at that pressure, see
 :meth:`EngagementOCP._cavitation_rows`); with a spring-applied piston, films h <= their gap at the kiss
 in the slip phase (the piston not behind the kiss point, Bao Eq. 13); optionally interface temperature <= max_temperature_C (a scene
 with [thermal]) and interface heat per friction area <= max_specific_power_W_mm2 (path constraints,
@@ -478,20 +478,24 @@ class EngagementOCP:
         return [int(name[2:]) for name in self._names if name.startswith("h_")]
 
     def _cavitation_rows(self, physical, subs, model):
-        """Path rows (>= 0): each film opens no faster than the averaged Reynolds film would at
-        CAVITATION_DEPTH x film.cavitation_pressure: (p_Reynolds - depth p_cav) / |p_cav|.
+        """Path rows (>= 0) for a pack behind a piston: each film opens no faster than the averaged Reynolds
+        film would at CAVITATION_DEPTH x film.cavitation_pressure, (p_Reynolds - depth p_cav) / |p_cav|.
 
         The film law limits the fluid load smoothly at p_cav (:mod:`clutchocp.physics.cavitation`): a
         film pulled harder cavitates and opens, its mean pressure held at about p_cav, and its Reynolds
         pressure (the mean pressure of the averaged Reynolds film at the same closing speed, without the
         limit) measures how fast it opens: -3 bar is three times the speed at which it starts to
-        cavitate. Faster, the opening is set by the limit's residual slope or the piston's mass (micro-
-        seconds, no mesh resolves it) and a cavity model of more standing (mass-conserving, with the
-        refilling of the cavity) would be needed. Measured: the optimum of default_driveline opens its
-        films to -2.6 bar (the row is inactive); bao2020's optimum without the row (or with depth 1)
-        did not converge in 500 IPOPT iterations, with depth 3 it verifies (IDAS lock-up within
-        0.04 %, jump 0.6 %, films at -1.002 bar); the limit alone keeps the mean film pressure at p_cav.
+        cavitate. A pack pressed by the pressure directly (no piston) opens quasi-statically once
+        cavitated, as fast as its asperities unload (C(h) = F - L), whatever the limit's residual slope,
+        so it gets no row: zhang2021's optimum opens its film that way (its mean pressure at -1.004 bar
+        in the IDAS replay); with the row at depth 3 its solve did not converge. Behind a piston the
+        pressure can pull the pack open, and then the piston's mass and the residual slope, not the
+        film, set how fast (microseconds, no mesh resolves it): bao2020's optimum without the row (or
+        with depth 1) did not converge in 500 IPOPT iterations, with depth 3 it verifies (IDAS lock-up
+        within 0.04 %, jump 0.6 %, films at -1.002 bar).
         """
+        if not model.has_piston:
+            return []
         p_cav = model.film.cavitation_pressure
         scale = max(abs(p_cav), 1e4)
         return [(subs(physical[f"film_{k}_reynolds_pressure_Pa"]) - CAVITATION_DEPTH * p_cav) / scale
@@ -539,7 +543,7 @@ class EngagementOCP:
             c_lb, c_ub = np.array([0.0, -1.0]), np.array([np.inf, 1.0])
         c_lb = np.append(c_lb, [-np.inf] * len(self.heat_limits))      # heat limits: value / limit <= 1
         c_ub = np.append(c_ub, [1.0] * len(self.heat_limits))
-        n_films = len(self._film_representatives())      # cavitation rows: Reynolds pressure >= depth p_cav
+        n_films = len(self._film_representatives()) if self.model.has_piston else 0    # cavitation rows
         c_lb, c_ub = np.append(c_lb, np.zeros(n_films)), np.append(c_ub, np.full(n_films, np.inf))
         p0 = self.scene.value("actuation.initial_pressure") / self.scales.pressure_Pa
         u_rate = np.array([self.rate_limit * self.scales.time_s / self.scales.pressure_Pa]) \

@@ -6,6 +6,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
+from clutchocp.engagement.run import simulate_engagement
 from clutchocp.errors import ModelError, SolverError
 from clutchocp.optimal import EngagementOCP, run_optimize, simulate_baselines, verify
 from clutchocp.optimal.replay import CommandModel, simulate_command
@@ -191,3 +192,12 @@ def test_run_optimize_writes_the_files(tmp_path):
     assert float(rows[-1].split(",")[1]) == pytest.approx(clamp["clamp_pressure_Pa"])
     assert clamp["capacity_margin_at_end"] == pytest.approx(1.3, rel=5e-3)
     assert summary["optimal"] == data["optimal"]
+    # the IDAS replay of the optimum, with the columns of the simulate command's time series
+    replay_columns = (tmp_path / "timeseries.csv").read_text().splitlines()[0].split(",")
+    assert replay_columns == list(simulate_engagement(default_scene(), t_end=0.05).series())
+    # a realisable optimum: no film pulled below the cavitation pressure (the film law limits it there)
+    p_cav = data["film_cavitation_pressure_Pa"]
+    assert p_cav == -1e5
+    assert data["verification"]["idas"]["min_film_pressure_Pa"] >= 1.1 * p_cav
+    assert data["verification"]["collocation"]["min_film_pressure_Pa"] == data["optimal"]["min_film_pressure_Pa"]
+    assert all(entry["min_film_pressure_Pa"] >= 1.1 * p_cav for entry in [data["optimal"], *data["sweep"]])

@@ -12,7 +12,7 @@ from clutchocp.shiftcontrol.report import run_robust
 from clutchocp.scene.uncertainty import Uncertainty
 
 
-T_MAX = 0.3      # [s]; the constant 0.8 MPa command locks the nominal default scene at 0.285 s
+T_MAX = 0.3      # [s]; the constant 0.8 MPa command locks the nominal default scene at 0.157 s
 
 
 def _tasks(seed, n=2):

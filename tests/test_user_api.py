@@ -25,7 +25,7 @@ def bao():
 
 def test_simulate_takes_a_scene_name_and_has_a_short_repr(bao):
     text = repr(bao)
-    assert len(text) < 300 and "bao2020" in text and "lock-up 0.44" in text
+    assert len(text) < 300 and "bao2020" in text and "lock-up 0.4398" in text
     assert len(repr(bao.result)) < 300
 
 

@@ -487,12 +487,12 @@ class EngagementOCP:
         limit) measures how fast it opens: -3 bar is three times the speed at which it starts to
         cavitate. A pack pressed by the pressure directly (no piston) opens quasi-statically once
         cavitated, as fast as its asperities unload (C(h) = F - L), whatever the limit's residual slope,
-        so it gets no row: zhang2021's optimum opens its film that way (its mean pressure at -1.004 bar
+        so it gets no row: zhang2021's optimum opens its film that way (its mean pressure at -1.04 bar
         in the IDAS replay); with the row at depth 3 its solve did not converge. Behind a piston the
         pressure can pull the pack open, and then the piston's mass and the residual slope, not the
-        film, set how fast (microseconds, no mesh resolves it): bao2020's optimum without the row (or
-        with depth 1) did not converge in 500 IPOPT iterations, with depth 3 it verifies (IDAS lock-up
-        within 0.04 %, jump 0.6 %, films at -1.002 bar).
+        film, set how fast (microseconds, no mesh resolves it), and the residual resistance adds suction:
+        bao2020's optimum without the row verifies but pulls its films to -1.23 bar in the IDAS replay;
+        with depth 3 it verifies (IDAS lock-up within 0.03 %, jump 0.61 %) with its films at -1.02 bar.
         """
         if not model.has_piston:
             return []

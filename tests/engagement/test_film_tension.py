@@ -13,7 +13,7 @@ with L = p_cav A (physics/cavitation.py).
   beyond it x = L + (F - L) / eps: a cavitated film opens 1 / eps times faster than the excess alone
   would squeeze it.
 * A disc of mass m: m dc/dt = F - g(K c); once cavitated (K c well below L) the film holds L and the disc
-  accelerates at (F - L) / m = -(|F| - |p_cav| A) / m, less the residual resistance eps K |c|.
+  accelerates at (F - L) / m = -(|F| - |p_cav| A) / m (to eps), less the residual resistance eps K |c|.
 """
 
 import math
@@ -21,6 +21,7 @@ import math
 import casadi as ca
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 
 from clutchocp.engagement.measures import energy_balance
 from clutchocp.engagement.model import EngagementModel
@@ -84,24 +85,34 @@ def test_massless_discs_separate_by_the_closed_form(fraction):
 
 
 def test_disc_with_mass_accelerates_at_the_excess_over_the_suction_limit():
-    """A disc of 0.5 kg pulled by |F| = 2 |p_cav| A: once cavitated it accelerates at (|F| - |p_cav| A) / m
-    (within the residual resistance eps K |c|, < 2 % over the window), and the film holds p_cav."""
+    """A disc of 0.5 kg pulled by |F| = 2 |p_cav| A: once cavitated (K c well below L) the film carries
+    L + eps (K c - L), so m dc/dt = F - L - eps (K c - L): from rest the disc accelerates at
+    (F - (1 - eps) L) / m = -(|F| - (1 - eps) |p_cav| A) / m, less the residual resistance eps K |c|
+    (K = K_g eta / h^3 along the run). IDAS follows that reduced law to 2e-3 over 5-15 us."""
     m = 0.5
     pressure = 2 * P_CAV
     model, result = _pull(pressure, 15e-6, points=301, **{"pack.model": "masses", "pack.plate_masses": [m]})
     film = model.film
     F, L = pressure * film.area, P_CAV * film.area
-    t, c = result.t, result["film_1_closing_speed_m_s"]
+    t, c, h = result.t, result["film_1_closing_speed_m_s"], result["h_1_m"]
+    K_g_eta = _squeeze_constant(model)
     window = t >= 5e-6
-    accel = np.polyfit(t[window], c[window], 1)[0]
-    expected = (F - L) / m                                     # negative: opening
-    assert expected * 1.02 < accel < expected * 0.99
-    # the film is cavitated over the window: its mean pressure within 2 % of p_cav, never 10 % below it
+
+    def reduced(tk, ck):
+        K = K_g_eta / np.interp(tk, t, h) ** 3
+        return [(F - L - RESIDUAL_SLOPE * (K * ck[0] - L)) / m]
+
+    sol = solve_ivp(reduced, (t[window][0], t[-1]), [c[window][0]], t_eval=t[window], rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(c[window], sol.y[0], rtol=2e-3)
+    a0 = (F - (1 - RESIDUAL_SLOPE) * L) / m                    # from rest: the excess over the suction limit
+    assert a0 == pytest.approx((F - L) / m, rel=2 * RESIDUAL_SLOPE)
+    # the film is cavitated over the window: its mean pressure is the limit plus the residual resistance,
+    # (L + eps (K c - L)) / A (1.035 -> 1.115 x p_cav as the disc speeds up)
     p_mean = result["film_1_mean_pressure_Pa"][window]
-    assert np.all(np.abs(p_mean / P_CAV - 1) < 0.02)
-    assert result["film_1_mean_pressure_Pa"].min() > 1.1 * P_CAV
+    K_run = K_g_eta / h[window] ** 3
+    np.testing.assert_allclose(p_mean, (L + RESIDUAL_SLOPE * (K_run * c[window] - L)) / film.area, rtol=2e-3)
     # the linear film would hold the whole pull and let the disc open at |F| / K at most
-    K = _squeeze_constant(model) / model.H0**3
+    K = K_g_eta / model.H0**3
     assert abs(c[-1]) > 5 * abs(F) / K
     assert energy_balance(model, result)["rel_error"] < 1e-6
 

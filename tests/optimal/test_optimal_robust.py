@@ -62,9 +62,11 @@ def test_one_scenario_is_the_nominal_problem(scene, nominal):
 
 
 def test_a_margin_on_t_max_is_the_nominal_problem_at_the_shorter_limit(scene, nominal):
-    """One scenario with t_max_margin m: the nominal optimum with t_max (1 - m), solved separately."""
+    """One scenario with t_max_margin m: the nominal optimum with t_max (1 - m), solved separately. (m = 5 %:
+    with the transmitted shear factor no command locks the default scene jump-free by 0.9 t_max on 10
+    intervals, the plain problem included: IPOPT reports it infeasible.)"""
     ocp, opt = nominal
-    margin = 0.1
+    margin = 0.05
     res = solve_robust(scene, [{}], intervals=N, t_max=opt.t_max, t_max_margin=margin)
     short = EngagementOCP(scene, intervals=N, baseline=ocp.baseline).solve(t_max=(1 - margin) * opt.t_max)
     assert res.t_max == pytest.approx((1 - margin) * opt.t_max, rel=1e-12)

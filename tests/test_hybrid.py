@@ -326,9 +326,14 @@ def test_solver_error_says_when_where_why_and_what_to_try():
     blow_up = Mode("blow", {"x": x}, {"x": x**2}, x_nominal={"x": 2.0})  # x = 1 / (1 - t): singular at t = 1
     with pytest.raises(SolverError) as info:
         simulate(HybridModel([blow_up]), {"x": 1.0}, np.linspace(0, 2, 5))
+    err = info.value                            # an ODE mode: CVODES (BDF) by default
+    assert err.mode == "blow" and 0.9 < err.t <= 1.0 and err.flag.startswith("CV_")
+    assert str(err).startswith("CVODES failed") and "t = " in str(err) and "x = " in str(err) and "Try:" in str(err)
+    with pytest.raises(SolverError) as info:
+        simulate(HybridModel([blow_up]), {"x": 1.0}, np.linspace(0, 2, 5), options=SimulationOptions(ode_integrator="idas"))
     err = info.value
     assert err.mode == "blow" and 0.9 < err.t <= 1.0 and err.flag.startswith("IDA_")
-    assert "t = " in str(err) and "x = " in str(err) and "Try:" in str(err)
+    assert str(err).startswith("IDAS failed") and "t = " in str(err) and "x = " in str(err) and "Try:" in str(err)
     with pytest.raises(SolverError, match=r"scipy Radau failed at t = (1|0\.99\d*) s in mode 'blow'.*Try:"):
         simulate(HybridModel([blow_up]), {"x": 1.0}, np.linspace(0, 2, 5), method="Radau")
 

@@ -69,6 +69,7 @@ FIRST_TIME = 1e-6       # IDACalcIC's trial step, as a fraction of the call's in
 SAFETY = 1.5            # a call ends beyond SAFETY x the predicted time to the next crossing
 PROBES = (0.9, 2.0)     # intermediate integrations inside a grid interval end at these multiples
                         # of the predicted time (first just before the crossing, then past it)
+SCHEMES = ("idas", "bdf", "adams")
 CACHE_SIZE = 64         # integrators kept per mode for irregular output patterns
 
 
@@ -168,37 +169,66 @@ class IdasPath:
         self.counters = {v: 0 for v in _COUNTERS.values()}
         self.counters.update(n_integrator_calls=0, n_location_integrations=0, n_probe_integrations=0,
                              n_integrators_built=0, integration_time_s=0.0)
-        self._options_key = repr(sorted(self._idas_options(1.0).items())) + f"native={options.native}"
+        self.counters.update({f"n_pieces_{k}": 0 for k in SCHEMES})
+        self._options_key = {k: repr(sorted(self._idas_options(1.0, k).items())) + f"native={options.native}"
+                             for k in SCHEMES}
+        self._schemes = {}          # mode name -> scheme of its current piece (begin_piece)
+        self._stiff = set()         # modes whose Adams integration failed in this run: BDF from then on
+
+    # ------------------------------------------------------------------ the integrator of a mode
+    def scheme_for(self, cm, t0, xs0, zs0, pu):
+        """The integrator of a piece of mode ``cm`` starting at ``(t0, xs0, zs0)``: ``"idas"``,
+        ``"bdf"`` (CVODES BDF) or ``"adams"`` (CVODES Adams-Moulton); see the module docstring."""
+        if self.plugin == "cvodes":
+            return "bdf"
+        choice = self.options.ode_integrator
+        if cm.nz or choice == "idas":
+            return "idas"
+        return "bdf" if cm.name in self._stiff else choice
+
+    def _solver(self, cm):
+        """Name of the integrator of the current piece of ``cm`` (for messages)."""
+        return "IDAS" if self._schemes.get(cm.name, "idas") == "idas" else "CVODES"
+
+    def begin_piece(self, cm, t0, xs0, zs0, pu):
+        """Choose the integrator of mode ``cm`` for the piece that starts here (every integration
+        of ``cm`` until the next call uses it) and return it."""
+        scheme = self._schemes[cm.name] = self.scheme_for(cm, t0, xs0, zs0, pu)
+        self.counters[f"n_pieces_{scheme}"] += 1
+        return scheme
 
     # ------------------------------------------------------------------ IDAS calls
-    def _idas_options(self, span):
+    def _idas_options(self, span, scheme):
         o = self.options
         # NaN/Inf in an evaluation is reported by the integrator's flag (IDA_RES_FAIL, ...) and
         # turned into a SolverError; CasADi's own per-evaluation warnings would flood stderr.
         opts = {"abstol": o.atol, "reltol": o.rtol, "max_num_steps": o.max_num_steps, "show_eval_warnings": False}
-        if self.plugin == "idas":
+        if scheme == "idas":
             opts.update(suppress_algebraic=o.suppress_algebraic, calc_ic=True, first_time=FIRST_TIME)
+        elif scheme == "adams":
+            opts["linear_multistep_method"] = "adams"
         if o.max_step is not None:
             opts["max_step_size"] = o.max_step / span          # normalised time
-        if self.plugin == "idas":
+        if scheme == "idas":
             opts.update(o.idas_options)
         return opts
 
-    def _integrator(self, cm, taus, span):
-        """The cached integrator of ``cm`` with outputs at normalised times ``taus``."""
+    def _integrator(self, cm, taus, span, scheme):
+        """The cached integrator (``scheme``) of ``cm`` with outputs at normalised times ``taus``."""
         n = len(taus)
         uniform = float(np.max(np.abs(taus - np.arange(1, n + 1) / n))) <= 1e-9
         pattern = n if uniform else tuple(np.round(taus, 12))
-        key = (self._options_key, pattern, span if self.options.max_step is not None else None)
-        cache = cm.integrators.setdefault(self.plugin, OrderedDict())
+        key = (self._options_key[scheme], pattern, span if self.options.max_step is not None else None)
+        cache = cm.integrators.setdefault(scheme, OrderedDict())
         entry = cache.get(key)
         if entry is None:
             if self.plugin == "cvodes" and cm.nz:
                 raise ModelError(f"method 'cvodes' integrates ODEs only: mode '{cm.name}' has algebraic variables "
                                  f"{cm.z_names}; use method='idas'")
+            plugin = "idas" if scheme == "idas" else "cvodes"
             grid = [k / n for k in range(1, n + 1)] if uniform else [float(x) for x in taus]
-            entry = _Integrator(ca.integrator(f"{self.plugin}_{cm.name}", self.plugin, self._dae(cm), 0.0, grid,
-                                              self._idas_options(span)), cm.nx, cm.nz, n)
+            entry = _Integrator(ca.integrator(f"{plugin}_{cm.name}", plugin, self._dae(cm), 0.0, grid,
+                                              self._idas_options(span, scheme)), cm.nx, cm.nz, n)
             self.counters["n_integrators_built"] += 1
             cache[key] = entry
             if len(cache) > CACHE_SIZE:
@@ -248,14 +278,19 @@ class IdasPath:
         span = float(times[-1] - t0)
         taus = (times - t0) / span
         p = np.concatenate([np.ravel(pu), [t0, span]])
+        scheme = self._schemes.get(cm.name) or self.begin_piece(cm, t0, xs0, zs0, pu)
         try:
-            return self._run(self._integrator(cm, taus, span), xs0, zs0, p)
+            return self._run(self._integrator(cm, taus, span, scheme), xs0, zs0, p)
         except _IdasFailure:
-            if cm.nz or self.plugin != "idas":
+            if scheme == "adams":       # stiff after all: BDF for this mode from here on
+                self._stiff.add(cm.name)
+                self._schemes[cm.name] = "bdf"
+                return self._run(self._integrator(cm, taus, span, "bdf"), xs0, zs0, p)
+            if cm.nz or scheme != "idas":
                 raise
         # an ODE mode: the consistent start derivative is f(x0); IDAS without IDACalcIC
         xdot = np.array(cm.f_ode(xs0, np.zeros(0), pu, t0), dtype=float).ravel() * span
-        opts = {**self._idas_options(span), "calc_ic": False, "init_xdot": xdot.tolist()}
+        opts = {**self._idas_options(span, "idas"), "calc_ic": False, "init_xdot": xdot.tolist()}
         self.counters["n_integrators_built"] += 1
         integrator = ca.integrator(f"idas_{cm.name}_fresh", "idas", self._dae(cm), 0.0, taus.tolist(), opts)
         return self._run(_Integrator(integrator, cm.nx, cm.nz, taus.size), xs0, zs0, p)
@@ -275,6 +310,7 @@ class IdasPath:
         o = self.options
         times = np.asarray(times, float)
         xs_a, zs_a = np.asarray(xs_a, float), np.asarray(zs_a, float)
+        self.begin_piece(cm, t_a, xs_a, zs_a, pu)
         left = _Point(t_a, xs_a, zs_a, self._events(cm, xs_a, zs_a, pu, t_a)[:, 0])
         blocks = []
         start, size, cap, probes = 0, o.chunk, None, 0
@@ -319,7 +355,7 @@ class IdasPath:
                 crossing = self._locate(cm, pu, left, right, crossings)
                 return _advance(blocks, cm, crossing)
             if failure is not None:
-                raise solver_error(self.name.upper(), failure.flag, targets[-1], cm, xs[:, -1], zs[:, -1])
+                raise solver_error(self._solver(cm), failure.flag, targets[-1], cm, xs[:, -1], zs[:, -1])
             left = _Point(targets[-1], xs[:, -1], zs[:, -1], s[:, -1])
             if t_probe is not None:
                 probes += 1
@@ -331,10 +367,12 @@ class IdasPath:
 
     def _plan(self, cm, left, pu, times, monitor, probes):
         """Grid intervals for the next call, or a probe time inside the next interval."""
-        tau = self._time_to_event(cm, left, pu, monitor)
+        tau, unknown = self._time_to_event(cm, left, pu, monitor)
         gap = times[0] - left.t
         if probes < len(PROBES) and PROBES[probes] * tau < 0.5 * gap:
             return 1, left.t + max(PROBES[probes] * tau, 1e-3 * gap)
+        if unknown:                     # a crossing the quadratic cannot see: one grid interval
+            return 1, None
         span = SAFETY * tau
         if not math.isfinite(span):
             return times.size, None
@@ -356,9 +394,13 @@ class IdasPath:
         return n
 
     def _time_to_event(self, cm, left, pu, monitor):
-        """Predicted time until an event can fire (quadratic in its time derivatives; inf if none)."""
+        """Predicted time until an event can fire (quadratic in its time derivatives; inf if none)
+        and whether an event's crossing is unknown: a function at rest (zero first derivative)
+        whose curvature points away from zero (e.g. a piston held against its stop while the fill
+        pressure, which will move it, builds up from zero; in the third derivative)."""
         if not cm.events:
-            return math.inf
+            return math.inf, False
+        unknown = False
         slopes = cm.event_slopes()(left.xs, left.zs, pu, left.t).reshape(3, len(cm.events)).T
         best = math.inf
         for i, spec in enumerate(cm.events):
@@ -370,8 +412,10 @@ class IdasPath:
             else:
                 continue
             s, s1, s2 = slopes[i]
-            best = min(best, first_positive_root(s - offset, s1, s2))
-        return best
+            root = first_positive_root(s - offset, s1, s2)
+            unknown = unknown or (s1 == 0 and s != offset and root == math.inf)
+            best = min(best, root)
+        return best, unknown
 
     def _reach(self, cm, left, pu, t_fail, fail, monitor, rel_tol=1e-7):
         """Farthest time in (left, t_fail) IDAS reaches, by bisection; stops early at an event crossing.
@@ -390,7 +434,7 @@ class IdasPath:
             if monitor.scan(left.s, self._events(cm, xs, zs, pu, mid)[:, 0])[0]:
                 break
         if best is None:
-            raise solver_error(self.name.upper(), fail.flag, left.t, cm, left.xs, left.zs)
+            raise solver_error(self._solver(cm), fail.flag, left.t, cm, left.xs, left.zs)
         return np.array([best[0]]), best[1].reshape(cm.nx, 1), best[2].reshape(cm.nz, 1)
 
     def _events(self, cm, xs, zs, pu, t):

@@ -382,3 +382,32 @@ def test_input_break_at_the_instant_of_an_event_is_applied():
     res = simulate(model, {"x": 0.0}, grid, u={"u": PiecewiseConstant([1.0], [0.0, 2.0])})
     assert res.event_times("full") == pytest.approx([1.0], abs=1e-9)
     assert res.final("x") == pytest.approx(3.0, rel=1e-9)   # 1 + 2 (2 - 1)
+
+
+def test_event_function_at_rest_curving_away_is_not_left_unwatched(monkeypatch):
+    """x'' = 1 - 10 t from rest at x = 1: the event x = 0 has zero slope and a curvature pointing
+    away at the start, so the quadratic prediction sees no crossing; the first call ends after one
+    grid interval (not at the end of the piece), the next prediction finds the crossing, and it is
+    located at the root of the closed form x = 1 + t^2 / 2 - 5 t^3 / 3."""
+    from clutchocp.simulation.idas_path import IdasPath
+
+    t = ca.SX.sym("t")
+    x, v = sym("x", "v")
+    fall = Mode("fall", {"x": x, "v": v}, {"x": v, "v": 1 - 10 * t},
+                events=[Event("land", x, "rest", direction=-1)])
+    rest = Mode("rest", {"x": x, "v": v}, {"x": 0 * x, "v": 0 * v})
+    ends = []
+    integrate = IdasPath._integrate
+
+    def traced(self, cm, t0, xs0, zs0, pu, times):
+        ends.append((cm.name, t0, float(np.atleast_1d(times)[-1])))
+        return integrate(self, cm, t0, xs0, zs0, pu, times)
+
+    monkeypatch.setattr(IdasPath, "_integrate", traced)
+    grid = np.linspace(0.0, 100.0, 10001)
+    result = simulate(HybridModel([fall, rest], t=t), {"x": 1.0, "v": 0.0}, grid, options=TIGHT)
+    root = min(r.real for r in np.roots([-5 / 3, 0.5, 0.0, 1.0]) if abs(r.imag) < 1e-12 and r.real > 0)
+    assert [e.name for e in result.events] == ["land"]
+    assert abs(result.events[0].t - root) <= 1e-9
+    assert ends[0] == ("fall", 0.0, pytest.approx(grid[1]))          # one interval first
+    assert max(end for name, _, end in ends if name == "fall") < 2.0  # never far past the landing

@@ -69,6 +69,7 @@ FIRST_TIME = 1e-6       # IDACalcIC's trial step, as a fraction of the call's in
 SAFETY = 1.5            # a call ends beyond SAFETY x the predicted time to the next crossing
 PROBES = (0.9, 2.0)     # intermediate integrations inside a grid interval end at these multiples
                         # of the predicted time (first just before the crossing, then past it)
+BLIND_GROWTH = 4        # a piece started with an unseen crossing: calls of 1, 4, 16, ... grid intervals
 SCHEMES = ("idas", "bdf", "adams")
 CACHE_SIZE = 64         # integrators kept per mode for irregular output patterns
 
@@ -313,10 +314,10 @@ class IdasPath:
         self.begin_piece(cm, t_a, xs_a, zs_a, pu)
         left = _Point(t_a, xs_a, zs_a, self._events(cm, xs_a, zs_a, pu, t_a)[:, 0])
         blocks = []
-        start, size, cap, probes = 0, o.chunk, None, 0
+        start, size, cap, probes, horizon = 0, o.chunk, None, 0, None
         while start < times.size:
             if o.chunk is None:
-                n, t_probe = self._plan(cm, left, pu, times[start:], monitor, probes)
+                n, t_probe, horizon = self._plan(cm, left, pu, times[start:], monitor, probes, horizon, start == 0)
             else:
                 n, t_probe = min(size, times.size - start), None
             if cap is not None:
@@ -365,19 +366,29 @@ class IdasPath:
             probes = 0
         return _advance(blocks, cm, None)
 
-    def _plan(self, cm, left, pu, times, monitor, probes):
-        """Grid intervals for the next call, or a probe time inside the next interval."""
+    def _plan(self, cm, left, pu, times, monitor, probes, horizon=None, first=False):
+        """Grid intervals for the next call, or a probe time inside the next interval, and the
+        horizon of the call after it.
+
+        A piece whose first call (``first``) sees an event function at rest curving away from zero
+        (:meth:`_time_to_event`) is watched with calls of 1, BLIND_GROWTH, BLIND_GROWTH^2, ... grid
+        intervals (``horizon``) until a crossing is predicted within one of them; other pieces are
+        planned by the prediction alone.
+        """
         tau, unknown = self._time_to_event(cm, left, pu, monitor)
         gap = times[0] - left.t
         if probes < len(PROBES) and PROBES[probes] * tau < 0.5 * gap:
-            return 1, left.t + max(PROBES[probes] * tau, 1e-3 * gap)
-        if unknown:                     # a crossing the quadratic cannot see: one grid interval
-            return 1, None
+            return 1, left.t + max(PROBES[probes] * tau, 1e-3 * gap), horizon
+        if first and unknown:
+            return 1, None, BLIND_GROWTH
         span = SAFETY * tau
-        if not math.isfinite(span):
-            return times.size, None
-        n = int(np.searchsorted(times, left.t + span, side="left")) + 1
-        return min(n, times.size), None
+        n = int(np.searchsorted(times, left.t + span, side="left")) + 1 if math.isfinite(span) else times.size
+        n = min(n, times.size)
+        if horizon is not None:
+            if n > horizon:
+                return horizon, None, horizon * BLIND_GROWTH
+            horizon = None                  # a crossing predicted within reach: predictions from here on
+        return n, None, horizon
 
     @staticmethod
     def _regular(t0, times, n):
@@ -413,7 +424,7 @@ class IdasPath:
                 continue
             s, s1, s2 = slopes[i]
             root = first_positive_root(s - offset, s1, s2)
-            unknown = unknown or (s1 == 0 and s != offset and root == math.inf)
+            unknown = unknown or (s1 == 0 and s2 != 0 and s != offset and root == math.inf)
             best = min(best, root)
         return best, unknown
 

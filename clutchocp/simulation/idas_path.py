@@ -375,7 +375,7 @@ class IdasPath:
         intervals (``horizon``) until a crossing is predicted within one of them; other pieces are
         planned by the prediction alone.
         """
-        tau, unknown = self._time_to_event(cm, left, pu, monitor)
+        tau, unknown = self._time_to_event(cm, left, pu, monitor, times[-1] - left.t)
         gap = times[0] - left.t
         if probes < len(PROBES) and PROBES[probes] * tau < 0.5 * gap:
             return 1, left.t + max(PROBES[probes] * tau, 1e-3 * gap), horizon
@@ -404,11 +404,13 @@ class IdasPath:
             return 1
         return n
 
-    def _time_to_event(self, cm, left, pu, monitor):
+    def _time_to_event(self, cm, left, pu, monitor, span=math.inf):
         """Predicted time until an event can fire (quadratic in its time derivatives; inf if none)
         and whether an event's crossing is unknown: a function at rest (zero first derivative)
-        whose curvature points away from zero (e.g. a piston held against its stop while the fill
-        pressure, which will move it, builds up from zero; in the third derivative)."""
+        whose curvature points away from zero and would move it by more than its distance from
+        zero within ``span`` [s] (e.g. a piston held against its stop while the fill pressure,
+        which will move it, builds up from zero; in the third derivative). A locked mode's
+        nearly constant function (curvature ~1e-10 of its value) is not unknown."""
         if not cm.events:
             return math.inf, False
         unknown = False
@@ -424,7 +426,7 @@ class IdasPath:
                 continue
             s, s1, s2 = slopes[i]
             root = first_positive_root(s - offset, s1, s2)
-            unknown = unknown or (s1 == 0 and s2 != 0 and s != offset and root == math.inf)
+            unknown = unknown or (s1 == 0 and root == math.inf and 0.5 * abs(s2) * span * span > abs(s - offset))
             best = min(best, root)
         return best, unknown
 

@@ -1,6 +1,7 @@
 """Tests of the hybrid DAE engine (clutchocp.simulation) against closed forms and a second integrator."""
 
 import itertools
+import math
 
 import casadi as ca
 import numpy as np
@@ -411,3 +412,41 @@ def test_event_function_at_rest_curving_away_is_not_left_unwatched(monkeypatch):
     assert abs(result.events[0].t - root) <= 1e-9
     assert ends[0] == ("fall", 0.0, pytest.approx(grid[1]))          # one interval first
     assert max(end for name, _, end in ends if name == "fall") < 2.0  # never far past the landing
+
+
+def test_each_mode_gets_its_integrator_and_the_same_closed_form():
+    """An ODE mode runs on CVODES, a mode with an algebraic variable on IDAS, in one run: both
+    pieces follow x = exp(-t) (then x = exp(-t1) exp(-2 (t - t1)) with z = 2 x), and the event
+    is located at x = 1/2; with ode_integrator='idas' both pieces run on IDAS to the same values."""
+    x, z = sym("x", "z")
+    ode = Mode("ode", {"x": x}, {"x": -x}, events=[Event("half", x - 0.5, "dae", direction=-1)])
+    dae = Mode("dae", {"x": x}, {"x": -z}, z={"z": z}, alg=[z - 2 * x], z_guess={"z": 1.0})
+    grid = np.linspace(0.0, 1.5, 31)
+    t1 = math.log(2.0)
+    exact = np.where(grid < t1, np.exp(-grid), 0.5 * np.exp(-2 * (grid - t1)))
+    runs = {}
+    for choice in ("bdf", "idas"):
+        options = SimulationOptions(rtol=1e-10, atol=1e-12, event_value_tol=1e-10, ode_integrator=choice)
+        runs[choice] = result = simulate(HybridModel([ode, dae]), {"x": 1.0}, grid, options=options)
+        assert abs(result.events[0].t - t1) <= 1e-8
+        on_grid = np.array([result["x"][np.searchsorted(result.t, g, side="right") - 1] for g in grid])
+        assert np.max(np.abs(on_grid - exact)) <= 1e-8
+    assert runs["bdf"].stats["n_pieces_bdf"] >= 1 and runs["bdf"].stats["n_pieces_idas"] >= 1
+    assert runs["idas"].stats["n_pieces_bdf"] == 0 and runs["idas"].stats["n_pieces_idas"] >= 2
+
+
+def test_a_failed_adams_call_is_redone_with_bdf():
+    """x' = -1e5 (x - cos t) is stiff: CVODES Adams exceeds its step limit, the call is redone with
+    BDF and the run ends on the slow manifold x ~ cos t (error ~ sin t / 1e5)."""
+    t = ca.SX.sym("t")
+    x = ca.SX.sym("x")
+    stiff = Mode("stiff", {"x": x}, {"x": -1e5 * (x - ca.cos(t))})
+    options = SimulationOptions(rtol=1e-8, atol=1e-10, ode_integrator="adams", max_num_steps=2000)
+    result = simulate(HybridModel([stiff], t=t), {"x": 1.0}, np.linspace(0.0, 2.0, 5), options=options)
+    assert abs(result.final("x") - math.cos(2.0)) <= 2e-5
+    assert result.stats["n_pieces_adams"] == 1 and result.stats["n_adams_redone_bdf"] == 1
+
+
+def test_ode_integrator_must_be_known():
+    with pytest.raises(ModelError, match="ode_integrator must be one of"):
+        SimulationOptions(ode_integrator="rk4")

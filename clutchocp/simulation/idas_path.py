@@ -190,7 +190,7 @@ class IdasPath:
         self.counters = {v: 0 for v in _COUNTERS.values()}
         self.counters.update(n_integrator_calls=0, n_location_integrations=0, n_probe_integrations=0,
                              n_integrators_built=0, integration_time_s=0.0)
-        self.counters.update({f"n_pieces_{k}": 0 for k in SCHEMES})
+        self.counters.update({f"n_pieces_{k}": 0 for k in SCHEMES}, n_adams_redone_bdf=0)
         self._options_key = {k: repr(sorted(self._idas_options(1.0, k).items())) + f"native={options.native}"
                              for k in SCHEMES}
         self._schemes = {}          # mode name -> scheme of its current piece (begin_piece)
@@ -308,6 +308,7 @@ class IdasPath:
             if scheme == "adams":       # stiff after all: BDF for this mode from here on
                 self._stiff.add(cm.name)
                 self._schemes[cm.name] = "bdf"
+                self.counters["n_adams_redone_bdf"] += 1
                 return self._run(self._integrator(cm, taus, span, "bdf"), xs0, zs0, p)
             if cm.nz or scheme != "idas":
                 raise

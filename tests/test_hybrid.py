@@ -331,7 +331,8 @@ def test_solver_error_says_when_where_why_and_what_to_try():
     assert err.mode == "blow" and 0.9 < err.t <= 1.0 and err.flag.startswith("CV_")
     assert str(err).startswith("CVODES failed") and "t = " in str(err) and "x = " in str(err) and "Try:" in str(err)
     with pytest.raises(SolverError) as info:
-        simulate(HybridModel([blow_up]), {"x": 1.0}, np.linspace(0, 2, 5), options=SimulationOptions(ode_integrator="idas"))
+        simulate(HybridModel([blow_up]), {"x": 1.0}, np.linspace(0, 2, 5),
+                 options=SimulationOptions(ode_integrator="idas"))
     err = info.value
     assert err.mode == "blow" and 0.9 < err.t <= 1.0 and err.flag.startswith("IDA_")
     assert str(err).startswith("IDAS failed") and "t = " in str(err) and "x = " in str(err) and "Try:" in str(err)

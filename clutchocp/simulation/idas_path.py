@@ -38,10 +38,11 @@ if no crossing is predicted). An event function at rest (zero slope) whose curva
 from zero hides its crossing from the quadratic (default_fill: the piston held back while the
 fill pressure builds up, in the third derivative; the first call ran to 1.5 s, 9 092 steps of
 them past the impact at 2.5 ms): such a piece is watched with calls of 1, 4, 16, ... grid
-intervals (``BLIND_GROWTH``) until a crossing is predicted within one. A crossing predicted well inside the next grid interval is
-approached by intermediate integrations (``PROBES``) that produce no output sample. Each call
-is a restart of IDAS (order 1, small first step), so fewer calls cost fewer steps; work
-integrated past an event is thrown away, so calls that end shortly after it waste little.
+intervals (``BLIND_GROWTH``) until a crossing is predicted within one. A crossing predicted well
+inside the next grid interval is approached by intermediate integrations (``PROBES``) that
+produce no output sample. Each call is a restart of the integrator (order 1, small first
+step), so fewer calls cost fewer steps; work integrated past an event is thrown away, so calls
+that end shortly after it waste little.
 After an event the first, partial grid interval is integrated on its own, and the rest of the
 piece in uniform chunks (measured on bao2020: one call from the impact on takes 2300 steps,
 a restart at the first grid point 2000). With ``chunk`` given, calls cover ``chunk`` grid
@@ -197,9 +198,9 @@ class IdasPath:
         self._stiff = set()         # modes whose Adams integration failed in this run: BDF from then on
 
     # ------------------------------------------------------------------ the integrator of a mode
-    def scheme_for(self, cm, t0, xs0, zs0, pu):
-        """The integrator of a piece of mode ``cm`` starting at ``(t0, xs0, zs0)``: ``"idas"``,
-        ``"bdf"`` (CVODES BDF) or ``"adams"`` (CVODES Adams-Moulton); see the module docstring."""
+    def scheme_for(self, cm):
+        """The integrator of mode ``cm``: ``"idas"``, ``"bdf"`` (CVODES BDF) or ``"adams"`` (CVODES
+        Adams-Moulton); see the module docstring."""
         if self.plugin == "cvodes":
             return "bdf"
         choice = self.options.ode_integrator
@@ -211,10 +212,10 @@ class IdasPath:
         """Name of the integrator of the current piece of ``cm`` (for messages)."""
         return "IDAS" if self._schemes.get(cm.name, "idas") == "idas" else "CVODES"
 
-    def begin_piece(self, cm, t0, xs0, zs0, pu):
-        """Choose the integrator of mode ``cm`` for the piece that starts here (every integration
-        of ``cm`` until the next call uses it) and return it."""
-        scheme = self._schemes[cm.name] = self.scheme_for(cm, t0, xs0, zs0, pu)
+    def begin_piece(self, cm):
+        """Choose the integrator of mode ``cm`` for the piece that starts now (every integration of
+        ``cm`` until the next call uses it), count the piece and return the integrator."""
+        scheme = self._schemes[cm.name] = self.scheme_for(cm)
         self.counters[f"n_pieces_{scheme}"] += 1
         return scheme
 
@@ -301,7 +302,7 @@ class IdasPath:
         span = float(times[-1] - t0)
         taus = (times - t0) / span
         p = np.concatenate([np.ravel(pu), [t0, span]])
-        scheme = self._schemes.get(cm.name) or self.begin_piece(cm, t0, xs0, zs0, pu)
+        scheme = self._schemes.get(cm.name) or self.begin_piece(cm)
         try:
             return self._run(self._integrator(cm, taus, span, scheme), xs0, zs0, p)
         except _IdasFailure:
@@ -334,7 +335,7 @@ class IdasPath:
         o = self.options
         times = np.asarray(times, float)
         xs_a, zs_a = np.asarray(xs_a, float), np.asarray(zs_a, float)
-        self.begin_piece(cm, t_a, xs_a, zs_a, pu)
+        self.begin_piece(cm)
         left = _Point(t_a, xs_a, zs_a, self._events(cm, xs_a, zs_a, pu, t_a)[:, 0])
         blocks = []
         start, size, cap, probes, horizon = 0, o.chunk, None, 0, None

@@ -1,7 +1,9 @@
 """Work-precision of the engagement simulation: error against run time for every integrator.
 
 Every method integrates the same CasADi-generated equations of a scene
-(:func:`clutchocp.engagement.run.simulate_engagement`): ``"idas"`` (the default engine),
+(:func:`clutchocp.engagement.run.simulate_engagement`): ``"idas"`` (the default engine: IDAS for
+modes with algebraic variables, CasADi's CVODES with BDF for the others, which all engagement
+modes are; ``SimulationOptions.ode_integrator``),
 ``"idas-native"`` (IDAS with the equations compiled to machine code), ``"cvodes"`` (CasADi's
 CVODES on the same normalised-time ODE; the engagement modes have no algebraic variables) and
 scipy's ``"Radau"``, ``"BDF"``, ``"LSODA"`` (the reduced ODE with the exact CasADi Jacobian).

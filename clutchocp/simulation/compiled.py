@@ -75,8 +75,7 @@ class ColumnFunction:
         self.n_out = function.size1_out(0)
         self._maps = {}
         self._max_maps = max_maps
-        self._calls = function.is_a("SXFunction") and any(
-            function.instruction_id(k) == ca.OP_CALL for k in range(function.n_instructions()))
+        self._calls = vectorized.calls_unregistered(function)
         self._numpy_built = False
         self._numpy_fn = None
         self._loop = loop

@@ -56,6 +56,12 @@ def test_speedups_divide_peer_time_by_idas_time_at_each_level():
     assert wp.headline(ratios["Radau"]) == (pytest.approx(7.0), pytest.approx(7.0), 2)
 
 
+def test_whole_over_floor_divides_the_whole_run_speedup_by_the_floor():
+    entry = {"speedup_vs_radau": 3.0, "floor_speedup_vs_radau": 6.0, "speedup_vs_lsoda": 2.0,
+             "floor_speedup_vs_lsoda": None}
+    assert bench_run.whole_over_floor(entry) == {"whole_over_floor_vs_radau": 0.5, "whole_over_floor_vs_lsoda": None}
+
+
 def test_growth_exponent_of_a_power_law():
     n = np.array([1, 2, 4, 8, 16])
     assert scaling.growth_exponent(n, 3e-3 * n**1.25) == pytest.approx(1.25, rel=1e-12)
@@ -217,6 +223,8 @@ def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
         assert end[1e-8] < end[1e-5], method
     for key in ("floor_speedup_vs_radau", "floor_speedup_vs_lsoda"):
         assert entry[key] is not None and entry[key] > 0
+    assert written["scenes"]["zhang2021"].keys() >= {"whole_over_floor_vs_radau", "whole_over_floor_vs_lsoda"}
+    assert entry["whole_over_floor_vs_radau"] == bench_run.whole_over_floor(entry)["whole_over_floor_vs_radau"]
     assert written["single_run_s"] == {}          # bao2020 not among the scenes: not timed
     text = bench_run.format_summary(summary)
     assert "issue" not in text and "target" not in text and "integrator floor" in text

@@ -55,10 +55,16 @@ def _load_file(tmp_path, speeds, torques):
     return str(path)
 
 
-def test_flat_load_table_equals_the_constant_load(tmp_path, rigid):
+def test_flat_load_table_equals_the_constant_load(tmp_path):
+    """The same load through a table and as a constant: the lock time agrees to 1e-9 when the
+    integration is tighter than that (at the scene's rtol 1e-8 the rounding differences of the two
+    forms may move CVODES's steps, and the lock time, by up to the tolerance: 4e-9 measured)."""
     file = _load_file(tmp_path, [0, 100, 400], [100, 100, 100])
-    table = run("default_driveline", **{"load.model": "table", "load.file": file, "load.torque": None})
-    assert table.summary["engagement_time_s"] == pytest.approx(rigid.summary["engagement_time_s"], rel=1e-9)
+    tight = {"rtol": 1e-11, "atol": 1e-13}
+    constant = simulate_engagement(load_scene("default_driveline"), **tight)
+    table = simulate_engagement(load_scene("default_driveline", overrides={
+        "load.model": "table", "load.file": file, "load.torque": None}), **tight)
+    assert table.summary["engagement_time_s"] == pytest.approx(constant.summary["engagement_time_s"], rel=1e-9)
 
 
 def test_load_table_from_a_quadratic_matches_the_quadratic_load(tmp_path):

@@ -1,6 +1,7 @@
 """Tests of the hybrid DAE engine (clutchocp.simulation) against closed forms and a second integrator."""
 
 import itertools
+import math
 
 import casadi as ca
 import numpy as np
@@ -326,9 +327,15 @@ def test_solver_error_says_when_where_why_and_what_to_try():
     blow_up = Mode("blow", {"x": x}, {"x": x**2}, x_nominal={"x": 2.0})  # x = 1 / (1 - t): singular at t = 1
     with pytest.raises(SolverError) as info:
         simulate(HybridModel([blow_up]), {"x": 1.0}, np.linspace(0, 2, 5))
+    err = info.value                            # an ODE mode: CVODES (BDF) by default
+    assert err.mode == "blow" and 0.9 < err.t <= 1.0 and err.flag.startswith("CV_")
+    assert str(err).startswith("CVODES failed") and "t = " in str(err) and "x = " in str(err) and "Try:" in str(err)
+    with pytest.raises(SolverError) as info:
+        simulate(HybridModel([blow_up]), {"x": 1.0}, np.linspace(0, 2, 5),
+                 options=SimulationOptions(ode_integrator="idas"))
     err = info.value
     assert err.mode == "blow" and 0.9 < err.t <= 1.0 and err.flag.startswith("IDA_")
-    assert "t = " in str(err) and "x = " in str(err) and "Try:" in str(err)
+    assert str(err).startswith("IDAS failed") and "t = " in str(err) and "x = " in str(err) and "Try:" in str(err)
     with pytest.raises(SolverError, match=r"scipy Radau failed at t = (1|0\.99\d*) s in mode 'blow'.*Try:"):
         simulate(HybridModel([blow_up]), {"x": 1.0}, np.linspace(0, 2, 5), method="Radau")
 
@@ -377,3 +384,70 @@ def test_input_break_at_the_instant_of_an_event_is_applied():
     res = simulate(model, {"x": 0.0}, grid, u={"u": PiecewiseConstant([1.0], [0.0, 2.0])})
     assert res.event_times("full") == pytest.approx([1.0], abs=1e-9)
     assert res.final("x") == pytest.approx(3.0, rel=1e-9)   # 1 + 2 (2 - 1)
+
+
+def test_event_function_at_rest_curving_away_is_not_left_unwatched(monkeypatch):
+    """x'' = 1 - 10 t from rest at x = 1: the event x = 0 has zero slope and a curvature pointing
+    away at the start, so the quadratic prediction sees no crossing; the first call ends after one
+    grid interval (not at the end of the piece), the next prediction finds the crossing, and it is
+    located at the root of the closed form x = 1 + t^2 / 2 - 5 t^3 / 3."""
+    from clutchocp.simulation.idas_path import IdasPath
+
+    t = ca.SX.sym("t")
+    x, v = sym("x", "v")
+    fall = Mode("fall", {"x": x, "v": v}, {"x": v, "v": 1 - 10 * t},
+                events=[Event("land", x, "rest", direction=-1)])
+    rest = Mode("rest", {"x": x, "v": v}, {"x": 0 * x, "v": 0 * v})
+    ends = []
+    integrate = IdasPath._integrate
+
+    def traced(self, cm, t0, xs0, zs0, pu, times):
+        ends.append((cm.name, t0, float(np.atleast_1d(times)[-1])))
+        return integrate(self, cm, t0, xs0, zs0, pu, times)
+
+    monkeypatch.setattr(IdasPath, "_integrate", traced)
+    grid = np.linspace(0.0, 100.0, 10001)
+    result = simulate(HybridModel([fall, rest], t=t), {"x": 1.0, "v": 0.0}, grid, options=TIGHT)
+    root = min(r.real for r in np.roots([-5 / 3, 0.5, 0.0, 1.0]) if abs(r.imag) < 1e-12 and r.real > 0)
+    assert [e.name for e in result.events] == ["land"]
+    assert abs(result.events[0].t - root) <= 1e-9
+    assert ends[0] == ("fall", 0.0, pytest.approx(grid[1]))          # one interval first
+    assert max(end for name, _, end in ends if name == "fall") < 2.0  # never far past the landing
+
+
+def test_each_mode_gets_its_integrator_and_the_same_closed_form():
+    """An ODE mode runs on CVODES, a mode with an algebraic variable on IDAS, in one run: both
+    pieces follow x = exp(-t) (then x = exp(-t1) exp(-2 (t - t1)) with z = 2 x), and the event
+    is located at x = 1/2; with ode_integrator='idas' both pieces run on IDAS to the same values."""
+    x, z = sym("x", "z")
+    ode = Mode("ode", {"x": x}, {"x": -x}, events=[Event("half", x - 0.5, "dae", direction=-1)])
+    dae = Mode("dae", {"x": x}, {"x": -z}, z={"z": z}, alg=[z - 2 * x], z_guess={"z": 1.0})
+    grid = np.linspace(0.0, 1.5, 31)
+    t1 = math.log(2.0)
+    exact = np.where(grid < t1, np.exp(-grid), 0.5 * np.exp(-2 * (grid - t1)))
+    runs = {}
+    for choice in ("bdf", "idas"):
+        options = SimulationOptions(rtol=1e-10, atol=1e-12, event_value_tol=1e-10, ode_integrator=choice)
+        runs[choice] = result = simulate(HybridModel([ode, dae]), {"x": 1.0}, grid, options=options)
+        assert abs(result.events[0].t - t1) <= 1e-8
+        on_grid = np.array([result["x"][np.searchsorted(result.t, g, side="right") - 1] for g in grid])
+        assert np.max(np.abs(on_grid - exact)) <= 1e-8
+    assert runs["bdf"].stats["n_pieces_bdf"] >= 1 and runs["bdf"].stats["n_pieces_idas"] >= 1
+    assert runs["idas"].stats["n_pieces_bdf"] == 0 and runs["idas"].stats["n_pieces_idas"] >= 2
+
+
+def test_a_failed_adams_call_is_redone_with_bdf():
+    """x' = -1e5 (x - cos t) is stiff: CVODES Adams exceeds its step limit, the call is redone with
+    BDF and the run ends on the slow manifold x ~ cos t (error ~ sin t / 1e5)."""
+    t = ca.SX.sym("t")
+    x = ca.SX.sym("x")
+    stiff = Mode("stiff", {"x": x}, {"x": -1e5 * (x - ca.cos(t))})
+    options = SimulationOptions(rtol=1e-8, atol=1e-10, ode_integrator="adams", max_num_steps=500)
+    result = simulate(HybridModel([stiff], t=t), {"x": 1.0}, np.linspace(0.0, 2.0, 5), options=options)
+    assert abs(result.final("x") - math.cos(2.0)) <= 2e-5
+    assert result.stats["n_pieces_adams"] == 1 and result.stats["n_adams_redone_bdf"] == 1
+
+
+def test_ode_integrator_must_be_known():
+    with pytest.raises(ModelError, match="ode_integrator must be one of"):
+        SimulationOptions(ode_integrator="rk4")

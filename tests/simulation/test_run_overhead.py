@@ -103,6 +103,7 @@ def test_scalar_calls_of_the_numpy_translation_share_padded_maps(monkeypatch):
     table = next(f.instructions_sx()[k].which_function() for k in range(f.n_instructions())
                  if f.instruction_id(k) == ca.OP_CALL)
     monkeypatch.setattr(vectorized, "_MAPS", {})          # the maps other tests left behind
+    monkeypatch.setattr(vectorized, "_TABLES", {})        # log F_5/2 is a registered table: CasADi here
     for n in (49, 51, 56):
         x = np.linspace(0.5, 3.0, n)
         got = vectorized._call(table, x)
@@ -183,8 +184,9 @@ def test_compiled_event_functions_give_the_same_run(driveline_runs):
 
 
 def test_functions_without_table_calls_switch_to_numpy_sooner(monkeypatch):
-    """From MIN_SAMPLES_PLAIN samples a function that calls no table is evaluated by its numpy form
-    (the same values to rounding); one that calls a table stays on CasADi's map up to MIN_SAMPLES."""
+    """From MIN_SAMPLES_PLAIN samples a function that calls no table, or only registered tables
+    (log F_5/2), is evaluated by its numpy form (the same values to rounding); one that calls
+    another table stays on CasADi's map up to MIN_SAMPLES."""
     import casadi as ca
 
     from clutchocp.physics.roughness import log_F52
@@ -193,16 +195,20 @@ def test_functions_without_table_calls_switch_to_numpy_sooner(monkeypatch):
 
     xs, zs, pu, t = ca.SX.sym("xs", 2), ca.SX.sym("zs", 0), ca.SX.sym("pu", 1), ca.SX.sym("t")
     plain = ColumnFunction(ca.Function("plain", [xs, zs, pu, t], [ca.vertcat(ca.exp(-xs[0]) * xs[1], pu * t)]))
-    table = ColumnFunction(ca.Function("table", [xs, zs, pu, t], [ca.vertcat(log_F52(1 + xs[0] ** 2), pu * t)]))
+    other = ca.interpolant("other_table", "linear", [[0.0, 1.0, 2.5, 5.0]], [1.0, 0.5, 2.0, 1.0])
+    table = ColumnFunction(ca.Function("table", [xs, zs, pu, t], [ca.vertcat(other(1 + xs[0] ** 2), pu * t)]))
+    registered = ColumnFunction(ca.Function("registered", [xs, zs, pu, t],
+                                            [ca.vertcat(log_F52(1 + xs[0] ** 2), pu * t)]))
     n = vectorized.MIN_SAMPLES_PLAIN + 72
     assert n < vectorized.MIN_SAMPLES
     rng = np.random.default_rng(5)
     X, Z, P, T = rng.uniform(0, 2, (2, n)), np.zeros((0, n)), np.array([0.7]), np.linspace(0, 1, n)
-    for column in (plain, table):
+    for column in (plain, table, registered):
         got = column(X, Z, P, T)
         reference = np.column_stack([np.array(column.function(X[:, k], Z[:, k], P, T[k])).ravel() for k in range(n)])
         assert np.allclose(got, reference, rtol=1e-14, atol=0)
-    assert not plain._maps and plain._numpy is not None           # numpy form, no map built
+    for column in (plain, registered):
+        assert not column._maps and column._numpy is not None      # numpy form, no map built
     assert list(table._maps) == [vectorized.padded_size(n)]          # CasADi's map
 
 

@@ -65,18 +65,28 @@ def test_a_four_point_sweep_on_two_workers_equals_four_single_runs(tmp_path, sin
     assert not (tmp_path / "s" / LOCK).exists()
 
 
-def test_by_default_one_model_serves_every_point_and_agrees_with_the_single_runs(tmp_path, single_runs):
-    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID_2x2, engine="serial", progress=False)
+TIGHT = {"rtol": 1e-11, "atol": 1e-13}
+
+
+def test_by_default_one_model_serves_every_point_and_agrees_with_the_single_runs(tmp_path):
+    """The same equations with the values as parameters (constants folded in another order,
+    compiled C or CasADi's virtual machine: 1e-14 relative) agree with the single runs to 1e-9 when
+    integrated tighter than that. Not step for step: a rounding-level change may move the
+    integrator's step choices, and the results by up to its tolerance (zhang2021 at the scene's
+    rtol 1e-8, x0 changed by 3e-15 relative: IDAS 591 steps instead of 640, the dissipated energy
+    by 6.7e-8; CVODES 522 instead of 532)."""
+    base = load_scene("zhang2021")
+    single_runs = {(p, v): simulate_engagement(base.with_overrides({"actuation.pressure": p, "oil.viscosity": v}),
+                                               **TIGHT).summary
+                   for p in (3e5, 6e5) for v in (0.04, 0.06)}
+    summary = run_sweep("zhang2021", tmp_path / "s", grid=GRID_2x2, engine="serial", progress=False, options=TIGHT)
     rows = read_rows(tmp_path / "s")
     assert summary["points_model_reused"] == 4 and all(r["model_reused"] for r in rows)
     assert summary["native_code"]["used"] == (compiler() is not None)
     for row in rows:
         single = single_runs[row["actuation.pressure"], row["oil.viscosity"]]
-        assert row["n_steps"] == single["solver"]["statistics"]["n_steps"]
         assert row["final_mode"] == single["final_mode"]
         for key in SIMULATE_RESULTS[:-1]:
-            # the same equations with the values as parameters (constants folded in another order;
-            # measured: 1e-14 relative); compiled C or CasADi's virtual machine
             if single[key] is None:                   # e.g. a point that does not lock up within t_end
                 assert row[key] is None, key
                 continue
@@ -103,7 +113,8 @@ def test_a_failing_point_is_recorded_with_its_reason_and_the_sweep_goes_on(tmp_p
     rows = read_rows(tmp_path / "s")
     assert [r["status"] for r in rows] == ["ok", "failed", "failed"]
     for row in rows[1:]:
-        assert row["reason"].startswith("IDAS failed at t = ") and "Extreme case" in row["reason"]
+        assert row["reason"].startswith("CVODES failed at t = ") and "Extreme case" in row["reason"]
+        assert "did not converge" in row["reason"] or "error-test" in row["reason"] or "step limit" in row["reason"]
         assert "\n" not in row["reason"]
         assert all(row[k] is None for k in SIMULATE_COLUMNS[:-1] if k != "final_mode")   # no numbers but the time
         assert row["final_mode"] == ""

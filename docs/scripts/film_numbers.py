@@ -83,7 +83,8 @@ def main():
     for name in ("default_driveline", "default_driveline_thermal", "default_fill", "zhang2021", "bao2020",
                  "bao2020_as_published"):
         s = simulate_engagement(name).summary
-        print(f"  simulate {name}: lowest mean film pressure {s['min_film_pressure_Pa']:.4g} Pa (film "
+        print(f"  simulate {name}: lock-up {s['engagement_time_s']:.4g} s, lowest mean film pressure "
+              f"{s['min_film_pressure_Pa']:.4g} Pa (film "
               f"{s['min_film_pressure_film']} at {s['min_film_pressure_time_s']:.4g} s), energy balance "
               f"{s['energy_balance_rel_error']:.1e}")
 

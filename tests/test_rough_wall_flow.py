@@ -249,3 +249,19 @@ def test_rejects_negative_cutoff():
     with pytest.raises(ValueError, match="cutoff"):
         solve_film(s, 1.0, cutoff=-0.1)
     assert SHEAR_CUTOFF_GAP == pytest.approx(0.01)
+
+
+@pytest.mark.slow
+def test_transmitted_stress_converges_with_contact_lines():
+    # at Cui's cut-off 0.01 sigma the pressure near contact lines varies on 0.007 lambda: the
+    # depth-averaged-velocity evaluation converges on grids that do not resolve it (within 2 %
+    # from 32 cells per lambda), the face evaluation creeps up towards it (log of the cell)
+    for seed in (3, 4):
+        wall = gaussian_wall(4.0, np.random.default_rng(seed))
+        runs = {cpl: [solve_film(wall.on_grid(4 * cpl), H) for H in (0.5, 1.0, 2.0)] for cpl in (32, 64, 128)}
+        for coarse, fine in zip(runs[32] + runs[64], runs[128] + runs[128]):
+            assert coarse.smooth_drag == pytest.approx(fine.smooth_drag, rel=0.02)
+        for coarse, fine in zip(runs[32], runs[128]):
+            gap_coarse = fine.smooth_drag - coarse.smooth_drag_faces
+            gap_fine = fine.smooth_drag - fine.smooth_drag_faces
+            assert 0 < gap_fine < 0.75 * gap_coarse

@@ -77,3 +77,29 @@ def softplus(x, width):
 def smooth_step(x, width):
     """Smooth Heaviside step: 0.5 (1 + tanh(x / width)); equals 0.5 at x = 0."""
     return 0.5 * (1 + tanh(x / width))
+
+
+def apply_elementwise(function, x):
+    """Evaluate a scalar-in, scalar-out CasADi Function (e.g. an interpolant) elementwise.
+
+    Parameters
+    ----------
+    function : casadi.Function
+        One scalar input, one scalar output.
+    x : float, array or CasADi SX/MX/DM
+        Argument.
+
+    Returns
+    -------
+    Same shape as x: a CasADi matrix for CasADi input, else a numpy array (0-d for a float).
+    """
+    if is_symbolic(x):
+        if x.is_scalar():
+            return function(x)
+        n = x.numel()
+        row = function.map(n)(ca.reshape(x, 1, n))
+        return ca.reshape(row, x.size1(), x.size2())
+    arr = np.asarray(x, dtype=float)
+    if arr.size == 0:
+        return np.empty(arr.shape)
+    return np.array(function(arr.reshape(1, -1)), dtype=float).reshape(arr.shape)

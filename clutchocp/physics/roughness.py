@@ -14,7 +14,7 @@ import casadi as ca
 import numpy as np
 from scipy import integrate, special
 
-from .backend import erfc, exp, fmax, fmin, if_else, is_symbolic, log, softplus, sqrt
+from .backend import apply_elementwise, erfc, exp, fmax, fmin, if_else, is_symbolic, log, softplus, sqrt
 
 __all__ = [
     "combined_sigma",
@@ -136,17 +136,7 @@ def _log_f52_high(H):
 
 def _log_f52_spline(H):
     """Evaluate the B-spline elementwise on floats, arrays or CasADi matrices."""
-    if is_symbolic(H):
-        if H.is_scalar():
-            return _LOG_F52_SPLINE(H)
-        n = H.numel()
-        row = _LOG_F52_SPLINE.map(n)(ca.reshape(H, 1, n))
-        return ca.reshape(row, H.size1(), H.size2())
-    arr = np.asarray(H, dtype=float)
-    if arr.size == 0:
-        return np.empty(arr.shape)
-    values = np.array(_LOG_F52_SPLINE(arr.reshape(1, -1)), dtype=float)
-    return values.reshape(arr.shape)
+    return apply_elementwise(_LOG_F52_SPLINE, H)
 
 
 def log_F52(H):

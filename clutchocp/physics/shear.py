@@ -4,13 +4,28 @@ Cui 2019 Eq. 5-9: the average shear stress tau = eta (w1 - w2) r (phi_f - phi_fs
 the Patir & Cheng (1979) shear stress factors phi_f (Eq. 6) and phi_fs (Eq. 7-8), integrated
 over the land area of the annulus; Liao 2021 Eq. 2 for plates with radial grooves.
 
+Which wall, which sign. (phi_f - phi_fs), phi_fs = (V_r1 - V_r2) Phi_fs, is the mean *viscous*
+shear on surface 1. The torque the film transmits is the same on both plates (its momentum
+balance); on a rough wall it is the viscous shear plus the form drag of the pressure on the
+asperity flanks, on a smooth wall the viscous shear alone. With surface 1 smooth (V_r1 = 0,
+V_r2 = 1) Cui's factor is phi_f + Phi_fs, the transmitted one; with surface 1 rough it is
+phi_f - Phi_fs, the rough wall's viscous shear, short of the transmitted torque by the form
+drag 2 Phi_fs. Patir-Cheng's factors, linear in V_r, give phi_f + Phi_fs for any split of the
+roughness (wall i: viscous (V_rj - V_ri) Phi_fs plus form drag 2 V_ri Phi_fs, V_r1 + V_r2 = 1).
+Zhang 2021 (Sect. 2.1: w1 the separator, w2 the friction disc; Eq. 10: phi_f - phi_fs) with the
+smooth separator as surface 1 gets the plus sign. :func:`transmitted_shear_factor` gives the
+transmitted factor, by Patir-Cheng or by a deterministic-flow table (physics/rough_wall_flow.py);
+``viscous_torque(..., factors=...)`` uses it.
+
 Units: SI throughout (m, Pa s, rad/s, N m).
 """
 
+import casadi as ca
 import numpy as np
 
-from clutchocp.physics.backend import (exp, fmax, fmin, if_else, is_symbolic, log, softplus,
-                                       smooth_step)
+from clutchocp.physics import transmitted_shear_table
+from clutchocp.physics.backend import (apply_elementwise, exp, fmax, fmin, if_else, is_symbolic, log,
+                                       softplus, smooth_step)
 from clutchocp.physics.roughness import average_gap, combined_sigma
 
 EPS_STAR = 1.0 / 300.0          # Cui 2019 after Eq. 6: eps* = 0.00333 (cut-off film / 3 sigma)
@@ -146,7 +161,7 @@ def shear_factor_phi_fs(H, sigma_1, sigma_2, smooth=False, width=0.1):
 
 
 def viscous_torque(w_rel, h, eta, r1, r2, *, sigma_1=0.0, sigma_2=0.0, area_ratio=0.0,
-                   land_fraction=1.0, smooth=False, smooth_cutoff=False):
+                   land_fraction=1.0, smooth=False, smooth_cutoff=False, factors="cui"):
     """Viscous shear torque of one film between rough annular plates (Cui 2019 Eq. 9).
 
     T = (1 - A_c/A_n) psi (phi_f - phi_fs) pi eta w_rel (r2^4 - r1^4) / (2 h_T), with H = h/sigma,
@@ -178,22 +193,89 @@ def viscous_torque(w_rel, h, eta, r1, r2, *, sigma_1=0.0, sigma_2=0.0, area_rati
         roughness the exact cut (Cui Eq. 8) is a jump of the torque by Phi_fs(7) = 0.0127 of
         phi_f ~ 1.02, which an integrator has to step across (a stiff compliant-shaft DAE cannot);
         the smooth cut differs by < 5e-5 relative for H <= 6.5 and < 1e-6 absolute for H >= 7.5.
+    factors : {"cui", "patir_cheng", "table"}, keyword
+        "cui" (default): Cui's phi_f - phi_fs, the viscous shear on surface 1. "patir_cheng" and
+        "table": the transmitted factor of :func:`transmitted_shear_factor` (the torque both
+        plates feel), which does not depend on how the roughness is split.
 
     Returns
     -------
     T : same type as w_rel
         Viscous torque [N m], same sign as w_rel.
     """
+    if factors not in ("cui", "patir_cheng", "table"):
+        raise ValueError(f"factors must be 'cui', 'patir_cheng' or 'table', got {factors!r}")
     if _both_zero(sigma_1, sigma_2):
         factor, h_T = 1.0, h
     else:
         sigma = combined_sigma(sigma_1, sigma_2)
         H = h / sigma
-        factor = (shear_factor_phi_f(H, smooth=smooth)
-                  - shear_factor_phi_fs(H, sigma_1, sigma_2, smooth=smooth or smooth_cutoff))
+        if factors == "cui":
+            factor = (shear_factor_phi_f(H, smooth=smooth)
+                      - shear_factor_phi_fs(H, sigma_1, sigma_2, smooth=smooth or smooth_cutoff))
+        else:
+            factor = transmitted_shear_factor(H, method=factors, smooth=smooth,
+                                              smooth_cutoff=smooth_cutoff)
         h_T = average_gap(h, sigma)                                    # Bao Eq. 10
     # Cui 2019 Eq. 9
     return (1.0 - area_ratio) * land_fraction * factor * np.pi * eta * w_rel * (r2**4 - r1**4) / (2.0 * h_T)
+
+
+# Transmitted factor by deterministic flow: phi_T = 1 + u^2 y(u), u = 1 / (1 + H), y a C2 cubic
+# B-spline through the table (physics/transmitted_shear_table.py) and the far-field value y(0) = 2.5:
+# phi_T -> 1 + 2.5 / H^2, the Couette part E[h / h_loc] = 1 + 1/H^2 plus half the form drag,
+# 6 E[k_x^2 / k^2] (sigma / h)^2 = 3 / H^2 for an isotropic wall (second order in sigma / h).
+FAR_FIELD_TRANSMITTED = 2.5
+_TABLE_U = np.concatenate([[0.0], 1.0 / (1.0 + np.asarray(transmitted_shear_table.H)[::-1])])
+_TABLE_Y = np.concatenate([[FAR_FIELD_TRANSMITTED],
+                           ((np.asarray(transmitted_shear_table.PHI_T) - 1.0)
+                            * (1.0 + np.asarray(transmitted_shear_table.H)) ** 2)[::-1]])
+_TRANSMITTED_SPLINE = ca.interpolant("transmitted_y", "bspline", [_TABLE_U.tolist()], _TABLE_Y.tolist())
+
+
+def transmitted_shear_factor(H, method="patir_cheng", smooth=False, smooth_cutoff=False, width=0.05):
+    """Shear factor of the torque a film between a rough and a smooth wall transmits.
+
+    Replaces (phi_f - phi_fs) of Cui 2019 Eq. 9 (mean stress = eta (w1 - w2) r factor / h_T).
+
+    "patir_cheng": phi_f + Phi_fs (Cui Eq. 6 and 8): the viscous shear on the smooth wall, equal to
+    the rough wall's viscous shear phi_f - Phi_fs plus its form drag 2 Phi_fs (see the module
+    docstring for the sign). Jumps by Phi_fs(7) = 0.0127 at H = 7 unless smoothed.
+
+    "table": phi_T from the deterministic Reynolds flow over isotropic Gaussian rough walls
+    (physics/rough_wall_flow.py; no flow and no shear below the gap 3 eps* sigma = 0.01 sigma),
+    tabulated for 0 <= H <= 12 (standard error 1-4 % in the mixed range, see the table module) and
+    interpolated as 1 + u^2 y(u), u = 1 / (1 + H), with a C2 cubic B-spline y through the table and
+    y(0) = 2.5, so phi_T -> 1 + 2.5 / H^2 as H grows. H <= 0 uses the value at H = 0 (a kink there,
+    as phi_f's max(H, 0); ``smooth`` replaces max(H, 0) by softplus(H, width)).
+
+    Parameters
+    ----------
+    H : float, array or CasADi symbol
+        Film thickness ratio h / sigma [-].
+    method : {"patir_cheng", "table"}
+        Source of the factor.
+    smooth : bool
+        Smooth forms (phi_f, phi_fs as in :func:`shear_factor_phi_f`, :func:`shear_factor_phi_fs`;
+        the table's H <= 0 clamp by softplus).
+    smooth_cutoff : bool
+        Smooth cut-off of Phi_fs at H = 7 even with ``smooth=False`` ("patir_cheng" only).
+    width : float
+        Softplus width in H of the table's clamp with ``smooth=True`` [-].
+
+    Returns
+    -------
+    factor : same type as H
+        Transmitted shear factor [-].
+    """
+    if method == "patir_cheng":
+        return (shear_factor_phi_f(H, smooth=smooth)
+                + shear_factor_phi_fs(H, 1.0, 0.0, smooth=smooth or smooth_cutoff))
+    if method == "table":
+        Hp = softplus(H, width) if smooth else fmax(H, 0.0)
+        u = 1.0 / (1.0 + Hp)
+        return 1.0 + u * u * apply_elementwise(_TRANSMITTED_SPLINE, u)
+    raise ValueError(f"method must be 'patir_cheng' or 'table', got {method!r}")
 
 
 def grooved_viscous_torque(w_rel, h, eta, r1, r2, groove_depth, angle_ratio, n_films=1):

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from clutchocp.physics.rough_wall_flow import (SHEAR_CUTOFF_GAP, cosine_wall_closed_form, gaussian_wall,
-                                               periodic_wall_flow_1d, solve_film, wall_from_samples)
+                                               periodic_wall_flow_1d, solve_film, transmitted_shear_ensemble,
+                                               wall_from_samples)
 
 # ------------------------------------------------------------------------------ 1D, exact
 
@@ -135,17 +136,18 @@ def test_2d_solver_reproduces_exact_1d_cosine_wall():
     wall = wall_1d(lambda x: -eps * np.cos(x))               # gap H (1 + eps cos x)
     c = cosine_wall_closed_form(eps)
     unit = 1 / np.sqrt(1 - eps**2)                           # E[1/h]
-    errors = []
+    errors = {"smooth_drag": [], "rough_viscous": [], "form_drag": []}
     for n in (32, 64, 128):
         r = solve_film(wall.on_grid(n), H, cutoff=0.0)
-        assert r.smooth_drag / unit == pytest.approx(float(c.smooth_drag), rel=1e-6)
+        # the face evaluation is exact here (constant flux, trapezoidal means of a cosine)
         assert r.smooth_drag_faces / unit == pytest.approx(float(c.smooth_drag), rel=1e-12)
-        assert r.rough_viscous / unit == pytest.approx(float(c.rough_viscous), rel=1e-6)
-        errors.append(abs(r.form_drag / unit - float(c.form_drag)))
-    # the pressure-on-flank form drag converges at second order
-    assert errors[0] / errors[1] == pytest.approx(4, rel=0.05)
-    assert errors[1] / errors[2] == pytest.approx(4, rel=0.05)
-    assert errors[2] < 1e-4
+        for field in errors:
+            errors[field].append(abs(getattr(r, field) / unit - float(getattr(c, field))))
+    # the velocity-averaged shears and the pressure-on-flank form drag converge at second order
+    for e in errors.values():
+        assert e[0] / e[1] == pytest.approx(4, rel=0.05)
+        assert e[1] / e[2] == pytest.approx(4, rel=0.05)
+        assert e[2] < 2e-4
 
 
 def test_longitudinal_ridges_carry_no_pressure():
@@ -254,14 +256,21 @@ def test_rejects_negative_cutoff():
 @pytest.mark.slow
 def test_transmitted_stress_converges_with_contact_lines():
     # at Cui's cut-off 0.01 sigma the pressure near contact lines varies on 0.007 lambda: the
-    # depth-averaged-velocity evaluation converges on grids that do not resolve it (within 2 %
-    # from 32 cells per lambda), the face evaluation creeps up towards it (log of the cell)
+    # depth-averaged-velocity evaluation converges on grids that do not resolve it (within 3 % at
+    # 32 cells per lambda, the table's grid, 1.5 % at 64), the face evaluation creeps up towards it
+    # (log of the cell)
     for seed in (3, 4):
         wall = gaussian_wall(4.0, np.random.default_rng(seed))
         runs = {cpl: [solve_film(wall.on_grid(4 * cpl), H) for H in (0.5, 1.0, 2.0)] for cpl in (32, 64, 128)}
-        for coarse, fine in zip(runs[32] + runs[64], runs[128] + runs[128]):
-            assert coarse.smooth_drag == pytest.approx(fine.smooth_drag, rel=0.02)
+        for cpl, tolerance in ((32, 0.03), (64, 0.015)):
+            for coarse, fine in zip(runs[cpl], runs[128]):
+                assert coarse.smooth_drag == pytest.approx(fine.smooth_drag, rel=tolerance)
         for coarse, fine in zip(runs[32], runs[128]):
             gap_coarse = fine.smooth_drag - coarse.smooth_drag_faces
             gap_fine = fine.smooth_drag - fine.smooth_drag_faces
             assert 0 < gap_fine < 0.75 * gap_coarse
+
+
+def test_ensemble_needs_two_walls():
+    with pytest.raises(ValueError, match="n_walls"):
+        transmitted_shear_ensemble([3.0], 1)

@@ -20,9 +20,9 @@ import time
 
 from clutchocp.scene import default_scene
 from clutchocp.shiftcontrol.montecarlo import parallel_map, run_sample
-from clutchocp.shiftcontrol.report import build_strategies
+from clutchocp.shiftcontrol.workflow import build_strategies
 from clutchocp.shiftcontrol.spec import load_slip_spec
-from clutchocp.uncertainty import Uncertainty
+from clutchocp.scene.uncertainty import Uncertainty
 
 
 def main():

@@ -19,7 +19,7 @@ seeded draws of ``clutchocp robust`` in ``--workers`` processes: share of sample
 |jump| as % of the locked torque (median, p95, worst), the robust worst over the baseline worst, and
 samples per second (both strategies per sample).
 
-Defaults are the settings of ``clutchocp robust`` (``ROBUST_*`` in clutchocp/shiftcontrol/report.py).
+Defaults are the settings of ``clutchocp robust`` (``ROBUST_*`` in clutchocp/shiftcontrol/workflow.py).
 Run from the repository root:
 
     python benchmarks/bench_robust.py [--scenarios 1 3 5 9] [--intervals 12] [--presolve 0] [--jump-weight 1000]
@@ -46,7 +46,7 @@ from clutchocp.optimal.robust import AGGREGATES, PRESOLVE_INTERVALS, RobustOCP, 
 from clutchocp.optimal.replay import CommandModel, simulate_command
 from clutchocp.output import new_figure, save_figure
 from clutchocp.scene import default_scene
-from clutchocp.shiftcontrol.report import ROBUST_AGGREGATE, ROBUST_INTERVALS, ROBUST_T_MAX_MARGIN, ROBUST_WEIGHTS
+from clutchocp.shiftcontrol.workflow import ROBUST_AGGREGATE, ROBUST_INTERVALS, ROBUST_T_MAX_MARGIN, ROBUST_WEIGHTS
 
 def box_points(scene):
     """(corners, centre) of the scene's uncertainty box as override dicts [SI]."""
@@ -171,7 +171,7 @@ def montecarlo(scene, robust, samples, seed, workers):
     from clutchocp.shiftcontrol.design import pressure_limits
     from clutchocp.shiftcontrol.montecarlo import Strategy, parallel_map, run_sample, strategy_statistics
     from clutchocp.shiftcontrol.spec import load_slip_spec
-    from clutchocp.uncertainty import Uncertainty
+    from clutchocp.scene.uncertainty import Uncertainty
 
     spec = load_slip_spec()
     uncertainty = Uncertainty.from_scene(scene)

@@ -26,7 +26,7 @@ from clutchocp.scene import default_scene
 from clutchocp.shiftcontrol.closed_loop import run_closed_loop
 from clutchocp.shiftcontrol.schedule import design_schedule
 from clutchocp.shiftcontrol.spec import load_slip_spec
-from clutchocp.uncertainty import Uncertainty
+from clutchocp.scene.uncertainty import Uncertainty
 
 
 def main():

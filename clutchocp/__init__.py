@@ -49,6 +49,7 @@ def simulate(scene, *, overrides=None, rtol=None, atol=None, t_end=None, output_
         ``summary`` (the numbers of summary.json), ``table()`` (time series with units),
         ``plot(path=None)`` (overview figure).
     """
+    # imported here: at the top every clutchocp import (the CLI's too) loads SciPy's integrators
     from .engagement.run import simulate_engagement
     return simulate_engagement(_scene(scene, overrides), rtol=rtol, atol=atol, t_end=t_end,
                                output_points=output_points, method=method)
@@ -78,6 +79,7 @@ def optimize(scene=None, *, overrides=None, t_max=None, weights=None, intervals=
     clutchocp.optimal.outcome.OptimizationResult
         ``summary``, ``optimum``, ``replay``; ``table()`` (pressure profile), ``plot(path=None)``.
     """
+    # imported here: as simulate (the optimiser's modules only when asked for)
     from .optimal.report import optimize_scene
     scene = default_scene() if scene is None and not overrides else _scene(scene or default_scene(), overrides)
     return optimize_scene(scene, t_max=t_max, weights=weights, intervals=intervals, degree=degree, progress=progress)

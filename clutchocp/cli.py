@@ -4,9 +4,9 @@ Every user mistake ends in one line on stderr naming the field and what is allow
 Ctrl-C stops the run (also inside IDAS and IPOPT) with one line and exit code 130; no output folder
 is left that looks complete (results are written through :func:`clutchocp.output.output_folder`).
 
-Helpers for the commands' options (:func:`positive_float`, :func:`tolerance`, :func:`count`,
-:func:`parse_time_list`) are argparse ``type=`` functions: a bad value ends in one line naming the
-option and what is allowed.
+Helpers for the commands' options (:func:`positive_float`, :func:`tolerance`, :func:`count`) are
+argparse ``type=`` functions: a bad value ends in one line naming the option and what is allowed.
+The commands are the functions of :mod:`clutchocp.commands` named like them; ``scenes`` is here.
 """
 
 import argparse
@@ -14,13 +14,11 @@ import math
 import os
 import sys
 import warnings
-from pathlib import Path
-
-import numpy as np
 
 from . import interrupt
-from .errors import ClutchocpError, OptionError
-from .output import output_folder
+from .errors import ClutchocpError
+from .scene import list_scenes, load_scene
+from .scene.uncertainty import Uncertainty
 
 # Integration tolerances a user may ask for: tighter than 1e-14 is below double precision noise on
 # the scaled states; looser ones give results that only look like answers (bao2020 at rtol = atol:
@@ -29,7 +27,6 @@ from .output import output_folder
 TOLERANCE_RANGE = (1e-14, 1e-2)
 LOOSE_TOLERANCE = 1e-4
 MAX_INTERVALS = 2000      # collocation intervals: 2000 x degree 3 is ~10^5 NLP variables (minutes, GBs)
-MAX_SWEEP_POINTS = 50     # engagement-time limits in one sweep (each is a full IPOPT solve)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -100,37 +97,16 @@ def temperature(text):
     return value
 
 
-def parse_time_list(text, option):
-    """``"0.2,0.3,0.4"`` or ``"0.2:0.5:7"`` (start:stop:count) -> sorted distinct positive times [s].
-
-    Raises OptionError naming ``option`` for anything else (NaN, zero or negative times, a count
-    below 2 or above :data:`MAX_SWEEP_POINTS`, an empty list).
-    """
-    usage = f"{option} {text}: give positive times in seconds, '0.2,0.3,0.4' or start:stop:count like '0.2:0.5:7'"
-    try:
-        if ":" in text:
-            start, stop, n = text.split(":")
-            start, stop, n = float(start), float(stop), int(n)
-        else:
-            values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise OptionError(usage) from None
-    if ":" in text:
-        if not 2 <= n <= MAX_SWEEP_POINTS:
-            raise OptionError(f"{option} {text}: the count (after the second colon) must be from 2 to "
-                              f"{MAX_SWEEP_POINTS}")
-        values = np.linspace(start, stop, n)
-    if not len(values) or not all(math.isfinite(v) and v > 0 for v in values):
-        raise OptionError(usage)
-    values = sorted({float(v) for v in values})
-    if len(values) > MAX_SWEEP_POINTS:
-        raise OptionError(f"{option} {text}: at most {MAX_SWEEP_POINTS} times (each is a full solve)")
-    return values
+def _command(name):
+    """The command ``name`` of :mod:`clutchocp.commands`, imported when it runs."""
+    def run(args):
+        # imported here: --help, scenes and a mistyped option answer without loading the models
+        from . import commands
+        return getattr(commands, name)(args)
+    return run
 
 
 def _cmd_scenes(args):
-    from .scene import list_scenes, load_scene
-
     if args.scene:
         for name in args.scene:
             _describe(load_scene(name))
@@ -145,8 +121,6 @@ def _cmd_scenes(args):
 
 def _describe(scene):
     """Print a checked scene: its parts, their chosen variants and its uncertain fields."""
-    from .uncertainty import Uncertainty
-
     uncertainty = Uncertainty.from_scene(scene)
     print(f"{scene.name}: {scene.kind} scene, valid")
     print(f"  source: {scene.source}")
@@ -160,138 +134,6 @@ def _describe(scene):
             print(f"    {line}")
 
 
-def _cmd_validate(args):
-    from .analyses import run_validation
-
-    run_validation(args.out)
-    return 0
-
-
-def _cmd_simulate(args):
-    from .engagement.report import format_summary, write_engagement
-    from .engagement.run import simulate_engagement
-    from .scene import load_scene, parse_override
-
-    overrides = dict(parse_override(text) for text in args.set)
-    scene = load_scene(args.scene, overrides=overrides)
-    with output_folder(args.out) as folder:
-        run = simulate_engagement(scene, rtol=args.rtol, atol=args.atol, method=args.method, native=args.native)
-        print(format_summary(run.summary))
-        files = write_engagement(run, folder.path)
-    print(f"wrote {len(files)} files to {args.out}: {', '.join(f.name for f in files)}")
-    return 0
-
-
-def _cmd_cycles(args):
-    from tqdm import tqdm
-
-    from .engagement.cycles import format_cycles, run_cycles, write_cycles
-    from .scene import load_scene, parse_override
-
-    scene = load_scene(args.scene, overrides=dict(parse_override(text) for text in args.set))
-    with tqdm(total=args.cycles, desc="engagements", unit="cycle", file=sys.stderr) as bar:
-        def step(row):
-            bar.update(1)
-            bar.set_postfix_str(f"peak {row['peak_interface_temperature_C']:.1f} degC")
-        result = run_cycles(scene, cycles=args.cycles, cooling_time=args.cooling_time,
-                            max_temperature_C=args.max_temperature, progress=step)
-    print(format_cycles(result))
-    files = write_cycles(result, args.out)
-    print(f"wrote {len(files)} files to {args.out}: {', '.join(f.name for f in files)}")
-    return 0
-
-
-def _cmd_control(args):
-    from .hvd.report import run_control
-
-    run_control(args.scene, args.controller, out_dir=args.out)
-    return 0
-
-
-def parse_weights(text, option="--weights"):
-    """``"jerk=1,energy=0.1"`` -> {"jerk": 1.0, "energy": 0.1} (names and values checked by the solver)."""
-    usage = f"{option} {text!r}: write name=number pairs separated by commas, e.g. jerk=1,energy=0.1"
-    weights = {}
-    for item in (part.strip() for part in text.split(",")):
-        name, eq, value = item.partition("=")
-        try:
-            number = float(value)
-        except ValueError:
-            raise OptionError(usage) from None
-        if not eq or not name.strip():
-            raise OptionError(usage)
-        if name.strip() in weights:
-            raise OptionError(f"{option} {text!r}: '{name.strip()}' is given twice")
-        weights[name.strip()] = number
-    if not weights:
-        raise OptionError(usage)
-    return weights
-
-
-def _cmd_optimize(args):
-    from .optimal.problem import check_weights
-    from .optimal.report import run_optimize
-    from .scene import default_scene, load_scene, parse_override
-
-    overrides = dict(parse_override(text) for text in args.set)
-    if args.scene is None:
-        scene = default_scene().with_overrides(overrides) if overrides else default_scene()
-    else:
-        scene = load_scene(args.scene, overrides=overrides)
-    weights = parse_weights(args.weights) if args.weights is not None else None
-    if weights is not None:
-        check_weights(weights)             # before any solving
-    sweep = parse_time_list(args.sweep_t_max, "--sweep-t-max") if args.sweep_t_max is not None else None
-    run_optimize(scene, out_dir=args.out, t_max=args.t_max, weights=weights,
-                 intervals=args.intervals, degree=args.degree, sweep_t_max=sweep,
-                 max_temperature_C=args.max_temperature, max_specific_power_W_mm2=args.max_specific_power,
-                 clamp_margin=args.clamp_margin)
-    return 0
-
-
-def _cmd_robust(args):
-    from .shiftcontrol.report import run_robust
-
-    run_robust(args.scene, out_dir=args.out, samples=args.samples, seed=args.seed, uncertain=args.uncertain,
-               t_max=args.t_max, controller=args.controller, workers=args.workers, intervals=args.intervals)
-    return 0
-
-
-def _cmd_bench(args):
-    from .bench import format_summary, run_bench
-
-    summary = run_bench(args.out, quick=args.quick, progress=True)
-    print(format_summary(summary))
-    return 0
-
-
-def _cmd_sweep(args):
-    from .scene import parse_override
-    from .study import run_sweep
-
-    if args.scheduler and args.engine not in (None, "dask"):
-        raise OptionError(f"--scheduler {args.scheduler}: needs --engine dask (or no --engine)")
-    engine = args.engine or ("dask" if args.scheduler else "local")
-    options = {}
-    if args.task == "simulate":
-        options.update(native={"auto": "auto", "on": True, "off": False}[args.native],
-                       output_points=args.output_points, reuse_model=not args.model_per_point)
-    else:
-        options.update(intervals=args.intervals, degree=args.degree, t_max=args.t_max,
-                       weights=parse_weights(args.weights) if args.weights is not None else None,
-                       warm_start=not args.cold, verify=not args.no_verify, reuse_problem=not args.model_per_point)
-    summary = run_sweep(args.scene, args.out, task=args.task, grid=args.grid, samples=args.samples,
-                        seed=args.seed, uncertain=args.uncertain,
-                        overrides=dict(parse_override(text) for text in args.set), options=options,
-                        engine=engine, workers=args.workers, scheduler=args.scheduler, progress=True)
-    rate = summary["points_per_second"]
-    print(f"{summary['scene']} {summary['task']} sweep: {summary['points']} points, {summary['points_ok']} ok, "
-          f"{summary['points_failed']} failed, {summary['points_resumed']} resumed; "
-          f"{summary['wall_time_s']:.1f} s" + (f" ({rate:.2f} points/s)" if rate else ""))
-    print(f"wrote {args.out}: " + ", ".join(Path(f).name for f in summary["files"]) + ", results.csv")
-    return 0
-
-
 def build_parser():
     """The argument parser of the ``clutchocp`` command."""
     parser = _Parser(
@@ -299,12 +141,21 @@ def build_parser():
         description="Wet-clutch and hydro-viscous-drive simulation, optimal engagement pressure and control.",
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    _add_scene_commands(sub)
+    _add_optimize(sub)
+    _add_control_commands(sub)
+    _add_sweep(sub)
+    return parser
+
+
+def _add_scene_commands(sub):
+    """scenes, validate, simulate, cycles."""
     p = sub.add_parser("scenes", help="list the built-in scenes, one line each; or check the scenes named")
     p.add_argument("scene", nargs="*", help="scene name or TOML file to check and describe")
     p.set_defaults(run=_cmd_scenes)
     p = sub.add_parser("validate", help="static analyses against the seed papers' tables (Chen, Cui, Liao)")
     p.add_argument("--out", default="out/validate", help="output folder (default: out/validate)")
-    p.set_defaults(run=_cmd_validate)
+    p.set_defaults(run=_command("validate"))
     p = sub.add_parser("simulate", help="simulate an engagement scene through impact and lock-up (IDAS)")
     p.add_argument("scene", help="scene name (see 'clutchocp scenes') or TOML file")
     p.add_argument("--out", default="out/simulate", help="output folder (default: out/simulate); written when complete")
@@ -318,7 +169,7 @@ def build_parser():
                    help="integrator (default: idas)")
     p.add_argument("--native", action="store_true",
                    help="compile the equations to C with the system compiler first (faster repeated runs)")
-    p.set_defaults(run=_cmd_simulate)
+    p.set_defaults(run=_command("simulate"))
     p = sub.add_parser("cycles", help="repeated engagements with cooling between: temperature and engagement-time "
                                       "drift per cycle, until a limit (scene needs a [thermal] part)")
     p.add_argument("scene", help="engagement scene with a [thermal] part (e.g. default_driveline_thermal) or TOML file")
@@ -330,7 +181,12 @@ def build_parser():
     p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
                    help="override a scene value (repeatable)")
     p.add_argument("--out", default="out/cycles", help="output folder (default: out/cycles)")
-    p.set_defaults(run=_cmd_cycles)
+
+    p.set_defaults(run=_command("cycles"))
+
+
+def _add_optimize(sub):
+    """optimize."""
     p = sub.add_parser("optimize", help="optimal engagement pressure by direct collocation (the main job)")
     p.add_argument("scene", nargs="?", default=None, help="engagement scene (default: the default scene)")
     p.add_argument("--out", default="out/optimize", help="output folder (default: out/optimize)")
@@ -359,16 +215,21 @@ def build_parser():
     p.add_argument("--clamp-margin", type=positive_float, default=1.3, metavar="RATIO",
                    help="after lock-up, ramp to the clamp pressure whose static torque capacity is RATIO x "
                         "the locked torque (>= 1, default: 1.3)")
-    p.set_defaults(run=_cmd_optimize)
+
+    p.set_defaults(run=_command("optimize"))
+
+
+def _add_control_commands(sub):
+    """bench, control, robust."""
     p = sub.add_parser("bench", help="error against run time, stiffness and scaling (work-precision report)")
     p.add_argument("--quick", action="store_true", help="fewer tolerances, repeats and sizes, no native code (a few minutes)")
     p.add_argument("--out", default="out/bench", help="output folder (default: out/bench)")
-    p.set_defaults(run=_cmd_bench)
+    p.set_defaults(run=_command("bench"))
     p = sub.add_parser("control", help="hydro-viscous drive: operating points, linearisation, speed controller, closed loop")
     p.add_argument("scene", help="an hvd scene (e.g. liao2021_hvd, cui2019_hvd) or TOML file")
     p.add_argument("--controller", default=None, help="controller spec name (lqi, pi) or TOML file (default: lqi)")
     p.add_argument("--out", default="out/control", help="output folder (default: out/control)")
-    p.set_defaults(run=_cmd_control)
+    p.set_defaults(run=_command("control"))
     p = sub.add_parser("robust", help="Monte Carlo of shift-control strategies over the scene's uncertainty "
                                       "(baseline, nominal optimum, robust feedforward, slip feedback)")
     p.add_argument("scene", nargs="?", default=None, help="engagement scene (default: the default scene)")
@@ -384,7 +245,12 @@ def build_parser():
     p.add_argument("--workers", type=count(1, 1024, "parallel processes"), default=None,
                    help="parallel processes (default: the local cores)")
     p.add_argument("--intervals", type=count(2, MAX_INTERVALS, "collocation intervals"), default=60, help="collocation intervals of the optimisations (default: 60)")
-    p.set_defaults(run=_cmd_robust)
+
+    p.set_defaults(run=_command("robust"))
+
+
+def _add_sweep(sub):
+    """sweep."""
     p = sub.add_parser("sweep", help="many runs of a scene: a grid of operating points or Monte Carlo samples, "
                                      "on local processes or a Dask cluster")
     p.add_argument("scene", help="engagement scene name or TOML file")
@@ -425,8 +291,7 @@ def build_parser():
                    help="optimize: collocation points per interval (default: 3)")
     p.add_argument("--cold", action="store_true", help="optimize: no warm start from the neighbouring point")
     p.add_argument("--no-verify", action="store_true", help="optimize: skip the IDAS replay of each optimum")
-    p.set_defaults(run=_cmd_sweep)
-    return parser
+    p.set_defaults(run=_command("sweep"))
 
 
 def main(argv=None):
@@ -474,7 +339,6 @@ def main(argv=None):
         print(f"{name}: internal error ({type(exc).__name__}: {text}); please report it "
               "(CLUTCHOCP_DEBUG=1 shows the traceback)", file=sys.stderr)
         return 1
-
 
 
 def run():

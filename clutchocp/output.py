@@ -22,8 +22,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from . import interrupt
 from .errors import ModelError, OutputFolderError
@@ -283,6 +281,11 @@ def new_figure(n_panels=1, width=6.4, height=4.2):
     -------
     fig, axes : Figure and a list of Axes.
     """
+    # matplotlib (~0.3 s to import) loads with the first figure: the files of a run (CSV, JSON,
+    # folders) and the engine that writes them (``Table.to_csv``) do not need it
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(width * n_panels if n_panels > 1 else width, height), layout="constrained")
     FigureCanvasAgg(fig)
     axes = [fig.add_subplot(1, n_panels, k + 1) for k in range(n_panels)]

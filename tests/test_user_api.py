@@ -8,8 +8,9 @@ import pytest
 from matplotlib.figure import Figure
 
 import clutchocp
-from clutchocp.engagement import report as engagement_report
+from clutchocp.engagement import figures as engagement_figures
 from clutchocp.errors import ClutchocpError, PhysicalRangeError
+from clutchocp.optimal import figures as optimal_figures
 from clutchocp.optimal import report as optimal_report
 from clutchocp.optimal.bound import jerk_lower_bound, output_jerk_share
 from clutchocp.optimal.problem import check_weights
@@ -135,8 +136,8 @@ def legend_texts(fig):
 
 
 def test_spring_applied_pressure_figure_shows_the_piston_force(bao, monkeypatch, tmp_path):
-    figures = captured_figures(monkeypatch, engagement_report)
-    engagement_report.plot_engagement(bao, tmp_path)
+    figures = captured_figures(monkeypatch, engagement_figures)
+    engagement_figures.plot_engagement(bao, tmp_path)
     fig = figures["pressure.png"]
     force = [line for ax in fig.axes for line in ax.get_lines() if "piston" in str(line.get_label())]
     assert force and np.max(np.abs(force[0].get_ydata())) > 1.0          # kN, not a flat zero line
@@ -144,8 +145,8 @@ def test_spring_applied_pressure_figure_shows_the_piston_force(bao, monkeypatch,
 
 
 def test_film_figure_shows_the_early_transient(bao, monkeypatch, tmp_path):
-    figures = captured_figures(monkeypatch, engagement_report)
-    engagement_report.plot_engagement(bao, tmp_path)
+    figures = captured_figures(monkeypatch, engagement_figures)
+    engagement_figures.plot_engagement(bao, tmp_path)
     left = figures["gaps.png"].axes[0]
     assert left.get_xlim()[1] < 0.1 * bao.result.t[-1]          # the squeeze phase fills the panel
     assert all(any("lock-up at" in t for t in legend_texts(figures[name])) for name in figures)
@@ -199,8 +200,8 @@ def test_lock_time_difference_is_located_not_read_off_the_command_grid(best):
 
 
 def test_baselines_figure_compares_at_the_engagement_time(best, monkeypatch, tmp_path):
-    figures = captured_figures(monkeypatch, optimal_report)
-    optimal_report.plot_optimum(tmp_path, best.scene, best.optimum, best.replay, best.ocp.baseline,
+    figures = captured_figures(monkeypatch, optimal_figures)
+    optimal_figures.plot_optimum(tmp_path, best.scene, best.optimum, best.replay, best.ocp.baseline,
                                 best.baselines, best.summary)
     right = figures["baselines.png"].axes[1]
     assert "engagement" in right.get_xlabel()
@@ -243,8 +244,9 @@ def test_a_controller_limit_beyond_the_valve_warns_with_the_value():
 
 @pytest.mark.slow
 def test_closed_loop_figure_shows_valve_limits_and_load_steps(monkeypatch, tmp_path):
+    from clutchocp.hvd import figures as hvd_figures
     from clutchocp.hvd import report as hvd_report
-    figures = captured_figures(monkeypatch, hvd_report)
+    figures = captured_figures(monkeypatch, hvd_figures)
     hvd_report.run_control("liao2021_hvd", "pi", out_dir=tmp_path / "ctl", verbose=False)
     texts = legend_texts(figures["closed_loop.png"])
     assert any("valve limits" in t for t in texts) and any("load steps" in t for t in texts)

@@ -5,12 +5,14 @@ compares the numbers with the tables of its paper.
 
 * :mod:`~clutchocp.analyses.chen2021` — spline friction, pack torque vs Chen Tables 2-3;
 * :mod:`~clutchocp.analyses.cui2019` — mixed-friction torques vs film ratio, Eq. 18 vs Table 1;
-* :mod:`~clutchocp.analyses.liao2021` — film distribution of an HVC pack vs Liao Table 3.
+* :mod:`~clutchocp.analyses.liao2021` — film distribution of an HVC pack vs Liao Table 3;
+* :mod:`~clutchocp.analyses.figures` — the figures of all three, drawn from their results.
 """
 
 from pathlib import Path
 
 from clutchocp.analyses import chen2021, cui2019, liao2021
+from clutchocp.analyses.figures import draw
 from clutchocp.analyses.report import format_table
 from clutchocp.output import nest, shown, write_summary, writes_folder
 
@@ -41,6 +43,8 @@ def run_validation(out_dir, *, quiet=False):
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     results = [analysis.run(out_dir) for analysis in ANALYSES]
+    for res in results:
+        res.files.extend(draw(res, out_dir))
     summary = {}
     for res in results:
         summary.update(res.summary)

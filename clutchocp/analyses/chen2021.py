@@ -15,11 +15,12 @@ from pathlib import Path
 import numpy as np
 
 from clutchocp.analyses.report import AnalysisResult, pct
-from clutchocp.output import new_figure, save_figure, write_csv
+from clutchocp.output import write_csv
 from clutchocp.errors import ModelError
 from clutchocp.physics.friction import mu_chen2021
 from clutchocp.physics.spline import (attenuation_coefficient, equivalent_cof, interface_pressures,
                                       pack_torque, pack_torque_uniform)
+from clutchocp.scene import load_scene
 
 NAME = "chen2021"
 
@@ -166,7 +167,7 @@ def attenuation_curves(pressures, mu, spline_cof, n_pairs, *, r1, r2, **geometry
     return p, torque, torque_none
 
 
-def _reference(values, pressures, cof=None):
+def reference_values(values, pressures, cof=None):
     """Tabulated values at the given pressures (NaN where Chen has no entry)."""
     table = values if cof is None else values.get(round(float(cof), 6))
     out = np.full(len(pressures), np.nan)
@@ -180,14 +181,14 @@ def _reference(values, pressures, cof=None):
 
 
 def run(out_dir, scene=None):
-    """Run the Chen analysis on a scene (default: built-in ``chen2021``), write CSV/PNG files.
+    """Run the Chen analysis on a scene (default: built-in ``chen2021``), write its CSV files.
+
+    Its figures are drawn from the result by :mod:`clutchocp.analyses.figures`.
 
     Returns
     -------
     AnalysisResult
     """
-    from clutchocp.scene import load_scene
-
     scene = scene if scene is not None else load_scene("chen2021")
     out_dir = Path(out_dir)
     kw = from_scene(scene)
@@ -196,10 +197,10 @@ def run(out_dir, scene=None):
     r1, r2 = kw["r1"], kw["r2"]
 
     result = AnalysisResult(NAME, f"Chen 2021 spline friction ({scene.name}): six-pair pack torque")
-    bench = _reference(TABLE2_T6, p)
+    bench = reference_values(TABLE2_T6, p)
     pressure_col, cof_col, ours, paper, dev, bench_col, err = [], [], [], [], [], [], []
     for k, mu_s in enumerate(cofs):
-        ref = _reference(TABLE3_TORQUE, p, mu_s)
+        ref = reference_values(TABLE3_TORQUE, p, mu_s)
         for j in range(len(p)):
             pressure_col.append(p[j])
             cof_col.append(mu_s)
@@ -256,7 +257,7 @@ def run(out_dir, scene=None):
         cols[f"torque_at_{p0 / 1e6:g}MPa [N m]"] = res["fig_torque"][:, j]
         cols[f"torque_no_spline_at_{p0 / 1e6:g}MPa [N m]"] = res["fig_torque_none"][:, j]
     result.files.append(write_csv(out_dir / "chen2021_attenuation.csv", cols))
-    result.files.extend(_figures(out_dir, res, bench))
+    result.figure_data = {"res": res, "bench": bench}
     return result
 
 
@@ -299,42 +300,3 @@ def _finite_columns(columns):
 
 def _py(v):
     return float(v) if isinstance(v, (float, np.floating)) else v
-
-
-def _figures(out_dir, res, bench):
-    p, cofs = res["pressures"], res["spline_cofs"]
-    files = []
-    fig, (ax,) = new_figure()
-    fp = res["fig_pressures"]
-    idx = np.arange(1, fp.shape[0] + 1)
-    for j, p0 in enumerate(p):
-        ax.plot(np.r_[0, idx], np.r_[p0, fp[:, j]] / 1e6, "o-", ms=3, label=f"p0 = {p0 / 1e6:g} MPa")
-    ax.set_xlabel("friction pair (interface) number (0 = piston)")
-    ax.set_ylabel("contact pressure [MPa]")
-    ax.set_title(f"Pressure attenuation, spline COF {FIG7_SPLINE_COF} (Chen 2021 Fig. 7 analogue)")
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
-    files.append(save_figure(fig, out_dir / "chen2021_attenuation.png"))
-
-    fig, (ax1, ax2) = new_figure(2, width=5.2)
-    for k, mu_s in enumerate(cofs):
-        line, = ax1.plot(p / 1e6, res["torque"][k], "o-", label=f"clutchocp, mu_fs = {mu_s:g}")
-        ref = _reference(TABLE3_TORQUE, p, mu_s)
-        if np.isfinite(ref).any():
-            ax1.plot(p / 1e6, ref, "x", color=line.get_color(), ms=9, label=f"Chen Table 3, mu_fs = {mu_s:g}")
-    ax1.plot(p / 1e6, bench, "ks", mfc="none", label="bench T6* (Table 2)")
-    ax1.set_xlabel("applied pressure [MPa]")
-    ax1.set_ylabel("six-pair torque [N m]")
-    ax1.set_title("Pack torque vs Chen 2021 Tables 2-3")
-    ax1.legend(fontsize=8)
-    ax1.grid(alpha=0.3)
-    for j, p0 in enumerate(p):
-        line, = ax2.plot(idx, res["fig_torque"][:, j], "-", label=f"{p0 / 1e6:g} MPa")
-        ax2.plot(idx, res["fig_torque_none"][:, j], "--", color=line.get_color())
-    ax2.set_xlabel("number of friction pairs")
-    ax2.set_ylabel("torque [N m]")
-    ax2.set_title("Spline friction (solid) / none (dashed), Fig. 8 analogue")
-    ax2.legend(fontsize=8)
-    ax2.grid(alpha=0.3)
-    files.append(save_figure(fig, out_dir / "chen2021_torque.png"))
-    return files

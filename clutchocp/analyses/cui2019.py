@@ -20,13 +20,14 @@ from pathlib import Path
 import numpy as np
 
 from clutchocp.analyses.report import AnalysisResult, pct
-from clutchocp.output import new_figure, save_figure, write_csv
+from clutchocp.output import write_csv
 from clutchocp.errors import ModelError
 from clutchocp.physics.contact import effective_radius, greenwood_tripp_area_ratio, greenwood_tripp_pressure
 from clutchocp.physics.fractal import cui_nominal_area, fractal_contact_load
 from clutchocp.physics.friction import mu_cui2019
 from clutchocp.physics.roughness import average_gap, average_gap_patir, combined_sigma
 from clutchocp.physics.shear import viscous_torque
+from clutchocp.scene import load_scene
 
 NAME = "cui2019"
 
@@ -158,14 +159,14 @@ def _crossing(x, y):
 
 
 def run(out_dir, scene=None):
-    """Run the Cui analysis on a scene (default: built-in ``cui2019``), write CSV/PNG files.
+    """Run the Cui analysis on a scene (default: built-in ``cui2019``), write its CSV files.
+
+    Its figures are drawn from the result by :mod:`clutchocp.analyses.figures`.
 
     Returns
     -------
     AnalysisResult
     """
-    from clutchocp.scene import load_scene
-
     scene = scene if scene is not None else load_scene("cui2019")
     out_dir = Path(out_dir)
     result = AnalysisResult(NAME, f"Cui 2019 HVD mixed friction ({scene.name})")
@@ -223,49 +224,5 @@ def run(out_dir, scene=None):
             "contact_cof [-]": r["cof"], "asperity_torque [N m]": r["asperity_torque"],
             "total_torque [N m]": r["total_torque"]}
     result.files.append(write_csv(out_dir / "cui2019_mixed_friction.csv", cols))
-    result.files.extend(_figures(out_dir, r))
+    result.figure_data = {"r": r}
     return result
-
-
-def _figures(out_dir, r):
-    files = []
-    lam = r["film_ratio"]
-    fig, (a1, a2, a3) = new_figure(3, width=4.2)
-    p = np.linspace(0, 1.1e6, 200)
-    a1.plot(TABLE1_PRESSURE / 1e6, TABLE1_COF, "ks", mfc="none", label="Cui Table 1")
-    a1.plot(p / 1e6, mu_cui2019(p), "-", label="Cui Eq. 18")
-    a1.set_xlabel("contact pressure [MPa]")
-    a1.set_ylabel("contact friction coefficient [-]")
-    a1.set_title("Eq. 18 vs Table 1 (Fig. 8 analogue)")
-    a1.legend(fontsize=8)
-    a2.plot(lam, r["h"] * 1e6, "k--", label="nominal h")
-    a2.plot(lam, r["h_T"] * 1e6, "-", label="h_T exact (Gaussian)")
-    a2.plot(lam, r["h_T_patir"] * 1e6, ":", label="h_T Cui Eq. 1")
-    a2.set_xlabel("film thickness ratio lambda [-]")
-    a2.set_ylabel("film thickness [um]")
-    a2.set_title("Fig. 12 analogue")
-    a2.legend(fontsize=8)
-    a3.plot(lam, r["area_ratio"], "-")
-    a3.set_xlabel("film thickness ratio lambda [-]")
-    a3.set_ylabel("contact area ratio k_a [-]")
-    a3.set_title("Fig. 13 analogue (Greenwood-Tripp)")
-    for ax in (a1, a2, a3):
-        ax.grid(alpha=0.3)
-    files.append(save_figure(fig, out_dir / "cui2019_film_contact.png"))
-
-    fig, (b1, b2, b3) = new_figure(3, width=4.2)
-    b1.plot(lam, r["fluid_torque"], "-")
-    b1.set_title("Fluid torque (Fig. 14 analogue)")
-    b2.plot(lam, r["asperity_torque"], "-", color="C1")
-    b2.set_title("Asperity friction torque (Fig. 15 analogue)")
-    b3.plot(lam, r["fluid_torque"], "-", label="fluid")
-    b3.plot(lam, r["asperity_torque"], "-", label="asperity")
-    b3.plot(lam, r["total_torque"], "k-", lw=2, label="total")
-    b3.set_title("Total torque (Fig. 16a analogue)")
-    b3.legend(fontsize=8)
-    for ax in (b1, b2, b3):
-        ax.set_xlabel("film thickness ratio lambda [-]")
-        ax.set_ylabel("torque [N m]")
-        ax.grid(alpha=0.3)
-    files.append(save_figure(fig, out_dir / "cui2019_torque.png"))
-    return files

@@ -20,10 +20,11 @@ import numpy as np
 from scipy.optimize import brentq
 
 from clutchocp.analyses.report import AnalysisResult, pct
-from clutchocp.output import new_figure, save_figure, write_csv
+from clutchocp.output import write_csv
 from clutchocp.errors import ModelError
 from clutchocp.physics.hvc import film_distribution, modified_factors, revised_torque
 from clutchocp.physics.shear import grooved_viscous_torque
+from clutchocp.scene import load_scene
 
 NAME = "liao2021"
 MM = 1e-3
@@ -162,14 +163,14 @@ def unit_check(*, n_films, groove_depth, angle_ratio, first_film, value=0.1):
 
 
 def run(out_dir, scene=None):
-    """Run the Liao analysis on a scene (default: built-in ``liao2021``), write CSV/PNG files.
+    """Run the Liao analysis on a scene (default: built-in ``liao2021``), write its CSV files.
+
+    Its figures are drawn from the result by :mod:`clutchocp.analyses.figures`.
 
     Returns
     -------
     AnalysisResult
     """
-    from clutchocp.scene import load_scene
-
     scene = scene if scene is not None else load_scene("liao2021")
     out_dir = Path(out_dir)
     kw = from_scene(scene)
@@ -270,47 +271,5 @@ def run(out_dir, scene=None):
                         ", ".join("runaway" if g is None else f"{g:.4g}" for g in units.values()),
                         "per mm^2 (Table 3)", ""))
 
-    result.files.extend(_figures(out_dir, cases, t3, kw["n_films"]))
+    result.figure_data = {"cases": cases, "t3": t3, "n_films": kw["n_films"]}
     return result
-
-
-def _figures(out_dir, cases, t3, n_films):
-    files = []
-    idx = np.arange(1, n_films + 1)
-    titles = {"groove_depth": "Figs 4/5", "angle_ratio": "Figs 6/7", "k3_over_k1": "Figs 8/9"}
-    for what, ylabel, fname, scale in (("films", "film thickness [mm]", "liao2021_films.png", 1 / MM),
-                                       ("torques", "viscous torque per film [N m]", "liao2021_torque.png", 1.0)):
-        fig, axes = new_figure(3, width=4.2)
-        for ax, (name, cs) in zip(axes, cases.items()):
-            label, lscale, unit = SWEEP_LABELS[name]
-            for c in cs:
-                ax.plot(idx, np.asarray(c[what]) * scale, "o-", label=f"{label} = {c['value'] * lscale:g} {unit}")
-            ax.set_xlabel("film number (1 = piston side)")
-            ax.set_ylabel(ylabel)
-            ax.set_title(f"Liao 2021 {titles[name]} analogue")
-            ax.legend(fontsize=8)
-            ax.grid(alpha=0.3)
-        files.append(save_figure(fig, out_dir / fname))
-    if t3:
-        fig, (ax1, ax2) = new_figure(2, width=4.8)
-        ours = np.concatenate([r["alpha"] for r in t3])
-        paper = np.concatenate([r["alpha_paper"] for r in t3])
-        ax1.plot(paper, ours, "o", ms=4)
-        lim = [0, 1.1 * max(ours.max(), paper.max())]
-        ax1.plot(lim, lim, "k--", lw=0.8)
-        ax1.set_xlabel("alpha_i, Liao Table 3")
-        ax1.set_ylabel("alpha_i, clutchocp (first film from Table 3)")
-        ax1.set_title("Modified coefficients")
-        ax1.grid(alpha=0.3)
-        k = np.arange(1, len(t3) + 1)
-        ax2.plot(k, [r["torque_test"] for r in t3], "ks", mfc="none", label="test")
-        ax2.plot(k, [r["torque_original_paper"] for r in t3], "v", label="original formula (paper)")
-        ax2.plot(k, [r["torque_new_paper"] for r in t3], "x", ms=8, label="new formula (paper)")
-        ax2.plot(k, [r["torque_new"] for r in t3], "o", mfc="none", label="Eq. 14, clutchocp")
-        ax2.set_xlabel("Table 3 row")
-        ax2.set_ylabel("overall viscous torque [N m]")
-        ax2.set_title("Liao 2021 Table 3")
-        ax2.legend(fontsize=8)
-        ax2.grid(alpha=0.3)
-        files.append(save_figure(fig, out_dir / "liao2021_table3.png"))
-    return files

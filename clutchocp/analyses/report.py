@@ -19,6 +19,8 @@ class AnalysisResult:
         Printed table rows ``(quantity, clutchocp value, reference value, deviation)`` as strings.
     files : list of pathlib.Path
         CSV and PNG files written.
+    figure_data : dict
+        What its figures draw (keyword arguments of its function in :mod:`clutchocp.analyses.figures`).
     """
 
     name: str
@@ -26,6 +28,7 @@ class AnalysisResult:
     summary: dict = field(default_factory=dict)
     rows: list = field(default_factory=list)
     files: list = field(default_factory=list)
+    figure_data: dict = field(default_factory=dict)
 
 
 def format_table(results):

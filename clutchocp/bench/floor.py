@@ -6,8 +6,9 @@ after every switch are taken from the reference run, and each mode piece (refere
 reference event) is integrated in one call from the reference state at its start, with one
 output at its end and no event functions:
 
-* ``"idas"``: one CasADi IDAS call per piece, the same cached integrators, options and
-  consistent initialisation as the engine (:class:`~clutchocp.simulation.idas_path.IdasPath`);
+* ``"idas"``: one call per piece of the engine's integrator of that mode (IDAS, or CVODES for a
+  mode without algebraic variables), the same cached integrators, options and consistent
+  initialisation as the engine (:class:`~clutchocp.simulation.idas_path.IdasPath`);
 * ``"Radau"``, ``"LSODA"``: one ``solve_ivp`` per piece on the same reduced right-hand side and
   exact CasADi Jacobian as the engine's scipy path (:class:`~clutchocp.simulation.scipy_path.ScipyPath`).
 

@@ -19,8 +19,11 @@ import time
 
 import numpy as np
 
+from .. import optimal
+from ..engagement.run import simulate_engagement
 from ..errors import ClutchocpError
 from ..output import new_figure, save_figure, write_csv
+from ..scene.loader import default_scene
 
 FULL = {"meshes": [(25, 3), (50, 3), (100, 3), (200, 3), (50, 2), (50, 4), (50, 5)], "reference": (200, 4)}
 QUICK = {"meshes": [(25, 3), (50, 3), (100, 3), (50, 2), (50, 4)], "reference": (200, 4)}
@@ -29,11 +32,10 @@ QUICK = {"meshes": [(25, 3), (50, 3), (100, 3), (50, 2), (50, 4)], "reference": 
 def _optimal():
     """The optimisation package, or None with the reason it cannot be used."""
     try:
-        from .. import optimal
         for name in ("EngagementOCP", "verify"):
             getattr(optimal, name)
         return optimal, None
-    except (ImportError, AttributeError) as exc:
+    except AttributeError as exc:
         return None, f"clutchocp.optimal is not available ({exc})"
 
 
@@ -89,9 +91,6 @@ def convergence(out_dir, quick=False, progress=None):
     optimal, reason = _optimal()
     if optimal is None:
         return unavailable(reason)
-    from ..engagement.run import simulate_engagement
-    from ..scene.loader import default_scene
-
     settings = QUICK if quick else FULL
     scene = default_scene()
     baseline = simulate_engagement(scene)

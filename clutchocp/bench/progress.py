@@ -1,16 +1,17 @@
-"""A one-line-per-step progress display on stderr (silent when disabled)."""
+"""The progress of a benchmark on stderr: a tqdm bar (steps done, elapsed time) and a note line per step."""
 
 import sys
-import time
+
+from tqdm import tqdm
 
 
-class Progress:
-    """Counter, bar, elapsed time and a note for every finished step, written to ``stream``.
+class Progress(tqdm):
+    """A tqdm bar counting the steps of a benchmark, with a line above it for every note.
 
     Parameters
     ----------
     total : int
-        Number of steps expected (the bar is capped at full if more come).
+        Number of steps expected.
     enabled : bool
         False: print nothing.
     stream : file-like, optional
@@ -18,24 +19,15 @@ class Progress:
     """
 
     def __init__(self, total, enabled=True, stream=None):
-        self.total, self.done, self.enabled = max(int(total), 1), 0, enabled
-        self.stream = stream or sys.stderr
-        self.start = time.perf_counter()
-
-    @property
-    def elapsed(self):
-        """Seconds since the display started."""
-        return time.perf_counter() - self.start
+        super().__init__(total=max(int(total), 1), disable=not enabled, file=stream or sys.stderr, unit="step",
+                         dynamic_ncols=True)
 
     def step(self, text):
-        """Count one step and show ``text`` beside the bar."""
-        self.done += 1
+        """Count one step and write ``text`` above the bar."""
+        self.update(1)
         self.note(text)
 
     def note(self, text):
-        """Show ``text`` without counting a step."""
-        if not self.enabled:
-            return
-        filled = round(20 * min(self.done, self.total) / self.total)
-        self.stream.write(f"[{'#' * filled:<20}] {self.done:3d}/{self.total} {self.elapsed:6.1f} s  {text}\n")
-        self.stream.flush()
+        """Write ``text`` above the bar, after the elapsed time, without counting a step."""
+        if not self.disable:
+            self.write(f"{self.format_interval(self.format_dict['elapsed'])}  {text}", file=self.fp)

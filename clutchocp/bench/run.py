@@ -14,7 +14,9 @@
   the same ratios of the time spent inside the integrator calls alone (``*_integration``: IDAS
   or ``solve_ivp``, without the event checks on the output grid, the outputs and the summary);
   the integrator floor (``floor_speedup_vs_radau``, ``floor_speedup_vs_lsoda``: the integrators
-  alone with the event times known, :mod:`clutchocp.bench.floor`);
+  alone with the event times known, :mod:`clutchocp.bench.floor`) and the share of it whole runs
+  keep (``whole_over_floor_vs_radau``, ``whole_over_floor_vs_lsoda``: ``speedup_vs_<peer>`` /
+  ``floor_speedup_vs_<peer>``; 1 when a whole run costs over the floor what the peer's does);
   ``idas_slower``: every scene, peer and matched error level at which a peer was faster than IDAS
   (a measured fact, not a target); ``single_run_s``: one warm bao2020 engagement at its settings;
 * ``engagement_integrator_floor.csv`` -- the floor of every method and tolerance (also drawn,
@@ -66,7 +68,7 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
         No native-code IDAS, single timed runs (three for the engine methods), coarser
         optimisation meshes.
     progress : bool
-        One line per step on stderr.
+        A progress bar and one line per step on stderr.
     scenes : sequence of Scene, optional
         Default: every built-in engagement scene.
 
@@ -99,6 +101,7 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
         scaling_results[scene.name] = scaling.plate_pair_scaling(scene, pairs=scaling.PAIRS,
                                                                  repeats=settings["scaling_repeats"], progress=bar)
         per_scene[scene.name] = {**_scene_summary(res, profile, scaling_results[scene.name], speed_rows), **low}
+        per_scene[scene.name].update(whole_over_floor(per_scene[scene.name]))
 
     files.append(workprecision.write_rows(out / "engagement_work_precision.csv", [r for res in results for r in res["rows"]]))
     files.append(workprecision.write_rows(out / "engagement_integrator_floor.csv", [r for rows in floors.values() for r in rows],
@@ -123,6 +126,7 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
     files.append(write_summary(out / "summary.json", json_ready(summary)))
     summary["files"] = [shown(f) for f in files]
     bar.note(f"done in {summary['wall_time_s']:.0f} s; wrote {len(files)} files to {shown(out)}")
+    bar.close()
     return summary
 
 
@@ -157,6 +161,17 @@ def _scene_summary(res, profile, scale, speed_rows):
     entry["scaling"] = {k: scale[k] for k in ("pairs", "wall_time_s", "n_steps", "n_states", "engagement_time_s")}
     entry["stiffness"] = profile.summary()
     return entry
+
+
+def whole_over_floor(entry, peers=floor.PEERS):
+    """``{whole_over_floor_vs_<peer>: speedup_vs_<peer> / floor_speedup_vs_<peer>}`` of one scene's
+    summary entry (None where either is missing): how much of the integrator floor's lead whole
+    runs keep."""
+    out = {}
+    for peer in (p.lower() for p in peers):
+        whole, low = entry.get(f"speedup_vs_{peer}"), entry.get(f"floor_speedup_vs_{peer}")
+        out[f"whole_over_floor_vs_{peer}"] = whole / low if whole is not None and low else None
+    return out
 
 
 def idas_slower(per_scene):
@@ -217,7 +232,9 @@ def format_summary(summary):
                            for peer in ("radau", "bdf", "lsoda", "cvodes"))
         lines.append(f"    inside the integrator calls only: IDAS vs {inside}")
         lines.append(f"    integrator floor (event times known, one call per mode piece): IDAS vs Radau "
-                     f"{num(e.get('floor_speedup_vs_radau'))}x, LSODA {num(e.get('floor_speedup_vs_lsoda'))}x")
+                     f"{num(e.get('floor_speedup_vs_radau'))}x, LSODA {num(e.get('floor_speedup_vs_lsoda'))}x; "
+                     f"whole / floor: Radau {num(e.get('whole_over_floor_vs_radau'))}, "
+                     f"LSODA {num(e.get('whole_over_floor_vs_lsoda'))}")
         lines.append(f"    run time ~ pairs^{e['scaling_exponent_pairs']:.2f}; stiffness ratio up to "
                      f"{num(stiff['max_stiffness_ratio'], '{:.3g}')}, fastest time constant "
                      f"{num(stiff['min_time_constant_s'], '{:.3g}')} s")

@@ -1,7 +1,9 @@
 """Work-precision of the engagement simulation: error against run time for every integrator.
 
 Every method integrates the same CasADi-generated equations of a scene
-(:func:`clutchocp.engagement.run.simulate_engagement`): ``"idas"`` (the default engine),
+(:func:`clutchocp.engagement.run.simulate_engagement`): ``"idas"`` (the default engine: IDAS for
+modes with algebraic variables, CasADi's CVODES with BDF for the others, which all engagement
+modes are; ``SimulationOptions.ode_integrator``),
 ``"idas-native"`` (IDAS with the equations compiled to machine code), ``"cvodes"`` (CasADi's
 CVODES on the same normalised-time ODE; the engagement modes have no algebraic variables) and
 scipy's ``"Radau"``, ``"BDF"``, ``"LSODA"`` (the reduced ODE with the exact CasADi Jacobian).
@@ -222,13 +224,22 @@ def pareto_front(points):
 
 
 def time_at_error(points, level):
-    """Time to reach error ``level``: log-log interpolation along the Pareto front of (error, time)
-    points (the cheapest run that is at least that accurate); None outside the front's error range."""
+    """Time to reach error ``level``: the cheapest run at least that accurate, interpolated in log-log
+    along the Pareto front of (error, time) points.
+
+    None outside the errors the runs reached (below the most accurate run's, above the least
+    accurate run's). Between the front's least accurate point and a less accurate run that was not
+    cheaper (off the front: e.g. a single timing of a loose run stretched by a busy machine) the
+    cheapest run at least that accurate is the front's last point, and its time is returned.
+    """
     front = pareto_front(points)
-    if not front or not front[0][0] <= level <= front[-1][0]:
+    if not front:
         return None
-    if len(front) == 1:
-        return front[0][1]
+    reached = max(e for e, w in points if math.isfinite(e) and e > 0 and math.isfinite(w))
+    if not front[0][0] <= level <= reached:
+        return None
+    if level >= front[-1][0]:
+        return front[-1][1]
     for (e0, w0), (e1, w1) in itertools.pairwise(front):
         if e0 <= level <= e1:
             s = (math.log(level) - math.log(e0)) / (math.log(e1) - math.log(e0))

@@ -19,22 +19,45 @@ shape); a part that the scene does not declare adds no state:
 Modes are (axial phase) x (rotation): axial phase "approach" (piston travelling freely, plates at
 rest; only with a piston and free travel) or "pressing"; rotation "slip_forward" (w_in > w_out),
 "slip_reverse" or "locked"; a mode is named "<axial>_<rotation>". Events move between them: impact (Bao Eq. 22), lock-up and unlock.
+
+The piston (or its stand-in, which presses the pack with the pressure force p A) and the pack (plate
+masses or massless) are parts picked once from the scene (:mod:`clutchocp.engagement.piston`,
+:mod:`clutchocp.engagement.pack`), as the thermal part is (:mod:`clutchocp.engagement.thermal`): each
+brings its states, equations, outputs and events, so the builder asks no "is there a piston?".
 """
 
-import math
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
-from ..simulation.model import Event, HybridModel, Mode, time_derivative
+from ..simulation.derivative import time_derivative
+from ..simulation.model import Event, HybridModel, Mode
 from .actuation import Actuation, read_table
 from .films import FilmLaw
+from .pack import Pressing, pack_part
+from .piston import piston_part
 from .thermal import plate_thermal
 
 ENERGY_TERMS = ("E_source", "E_hydraulic", "E_load", "E_slip", "E_film", "E_contact", "E_seal", "E_spline", "E_shaft",
                 "E_impact", "E_convection")
 ROTATIONS = ("slip_forward", "slip_reverse", "locked")
+
+
+@dataclass
+class Turning:
+    """The driveline in one rotation mode: torques [N m], output acceleration [rad/s^2], the hub's
+    torque balance ``alg`` (a compliant shaft while slipping), shaft damping power [W], rates."""
+
+    T_in: object
+    T_load: object
+    T_clutch: object
+    a_out: object
+    alg: list
+    shaft_power: object
+    T_shaft: object
+    rates: dict
 
 
 class EngagementModel:
@@ -75,24 +98,38 @@ class EngagementModel:
         self.n_driving = 1 if scene.get("driveline.driving_films", "all") == "first" else self.n
         self.H0 = scene.value("pack.initial_gap")
         self.sigma = self.film.sigma if self.film.sigma > 0 else self.H0 / 10
-        self.has_piston = scene.has("piston")
-        self.masses = scene.variant("pack") == "masses"
         self.plate_masses = np.asarray(scene.get("pack.plate_masses", np.zeros(self.n)), dtype=float)
-        if self.masses and scene.has("spline"):
-            raise ModelError("spline: spline friction is modelled for the massless pack (pack.model = 'massless')")
+        # The piston (or the stand-in that presses the pack with p A) and the pack (plate masses or
+        # massless), picked once: each brings its own states, equations, outputs and events.
+        self.piston = piston_part(scene, self._pack_area())
+        self.pack = pack_part(scene, self.n, self.plate_masses)
         self.input_inertia = scene.value("driveline.input") == "inertia"
         self.output_inertia = scene.value("driveline.output") == "inertia"
-        self.travel = scene.get("piston.travel_to_pack", 0.0) if self.has_piston else 0.0
         self.t = ca.SX.sym("t")
         self._build_states()
         self.modes = {}
-        self.axial_phases = ("approach", "pressing") if self.travel > 0 else ("pressing",)
+        self.axial_phases = self.piston.axial_phases
         for axial in self.axial_phases:
             for rotation in ROTATIONS:
                 mode = self._build_mode(axial, rotation)
                 self.modes[mode.name] = mode
         inputs = {"pressure_command": pressure_command} if pressure_command is not None else None
         self.hybrid = HybridModel(list(self.modes.values()), u=inputs, t=self.t)
+
+    @property
+    def has_piston(self):
+        """True if the scene has a piston (read-only: the piston part was picked from the scene)."""
+        return self.piston.present
+
+    @property
+    def masses(self):
+        """True if the plates have masses (``pack.model = "masses"``; read-only)."""
+        return self.pack.has_masses
+
+    @property
+    def travel(self):
+        """Free travel of the piston before it meets plate 1 [m] (0 without a piston; read-only)."""
+        return self.piston.travel
 
     # -- states -------------------------------------------------------------------------------
     def _build_states(self):
@@ -111,14 +148,12 @@ class EngagementModel:
         # 56 700 steps, energy balance 7e-6; at 12 000 rpm: lock time 1.4e-5 off at rtol 1e-8);
         # with this scale: 1 700 / 2 400 steps, energy balance <= 7e-8, lock time within 4e-8.
         v_scale = self.H0 / (0.1 * max(s.value("simulation.t_end"), 1e-6))
-        if self.has_piston:
-            add("x0", max(self.travel, self.H0), 0.0)
-            add("v0", v_scale, 0.0)
+        for spec in self.piston.state_specs(self.H0, v_scale):
+            add(*spec)
         for i in range(self.n):
             add(f"h_{i + 1}", self.sigma, self.H0)
-        if self.masses:
-            for i in range(self.n):
-                add(f"v_{i + 1}", v_scale, 0.0)
+        for spec in self.pack.state_specs(v_scale):
+            add(*spec)
         if self.actuation.has_state:
             add("p_valve", max(s.value("actuation.pressure"), 1e5), s.value("actuation.initial_pressure"))
         w_scale = max(s.value("driveline.input_speed"), s.value("driveline.output_speed"), 1.0)
@@ -133,7 +168,7 @@ class EngagementModel:
             add(*spec)
         # Energy accumulators of the parts the scene has (a load, a piston seal, splines, a shaft)
         present = {"E_load": self.output_inertia and s.variant("load") not in ("", "none"),
-                   "E_seal": self.has_piston, "E_spline": s.has("spline"), "E_shaft": self.compliant,
+                   "E_seal": "E_seal" in self.piston.energy_terms, "E_spline": s.has("spline"), "E_shaft": self.compliant,
                    "E_convection": self.thermal.present}
         self.energy_terms = tuple(name for name in ENERGY_TERMS if present.get(name, True))
         for name in self.energy_terms:
@@ -179,59 +214,25 @@ class EngagementModel:
         return self.actuation.pressure(self.t, p_state)
 
     def piston_position(self, axial):
-        """Piston travel [m]: the state x0 while approaching; once it presses the pack, the free
-        travel plus the closure of the films (x0 = travel + sum (H0 - h_i), Bao Eq. 13), so the
-        integrated x0 is a record, not a second (drifting) copy of the pack geometry."""
-        if axial == "approach":
-            return self.state("x0")
-        return self.travel + sum(self.H0 - self.state(f"h_{i + 1}") for i in range(self.n))
+        """Piston travel [m] in axial phase ``axial`` (:meth:`~clutchocp.engagement.piston.Piston.position`)."""
+        return self.piston.position(self.state, axial, self.n, self.H0)
 
     def drive_force(self, p, x0):
         """Net axial force on the piston from oil pressure and springs [N] (before pack and seal)."""
-        s = self.scene
-        k = s.value("piston.spring_stiffness") * s.value("piston.spring_count")
-        area = s.value("piston.area")
-        if s.variant("piston") == "spring_applied":
-            return k * (s.value("piston.spring_preload") - x0) - p * area   # Bao Eq. 21
-        return p * area - k * (s.value("piston.spring_preload") + x0)
+        return self.piston.drive_force(p, x0)
 
     def spring_energy(self, x0):
-        s = self.scene
-        k = s.value("piston.spring_stiffness") * s.value("piston.spring_count")
-        if s.variant("piston") == "spring_applied":
-            return 0.5 * k * (s.value("piston.spring_preload") - x0) ** 2
-        return 0.5 * k * (s.value("piston.spring_preload") + x0) ** 2
+        """Energy in the piston springs at travel ``x0`` [J]."""
+        return self.piston.spring_energy(x0)
 
     def seal_coefficient(self):
         """Viscous seal friction coefficient eta L pi D / psi [N s/m] (Bao Eq. 16)."""
-        s = self.scene
-        return (s.value("oil.viscosity") * s.value("piston.seal_length") * math.pi * s.value("piston.seal_diameter")
-                / s.value("piston.seal_clearance"))
-
-    def _spline_deductions(self, torques):
-        """Cumulative spline-friction forces d_k taken from the pack force before film k [N].
-
-        A plate carrying torque T in its spline feels an axial friction mu_s T / (R_p cos alpha)
-        against its motion (Chen 2021 Eq. 1-4); the first plate has one friction face, the others two.
-        """
-        s = self.scene
-        if not s.has("spline"):
-            return [0.0] * self.n
-        mu_s = float(s.value("spline.friction_coefficients")[0])
-        kinds = ("separator", "friction") if s.value("spline.first") == "separator" else ("friction", "separator")
-        radius = {k: s.value(f"spline.pitch_radius_{k}") for k in kinds}
-        angle = {k: s.value(f"spline.pressure_angle_{k}") for k in kinds}
-        coeff = [mu_s / (radius[kinds[i % 2]] * math.cos(angle[kinds[i % 2]])) for i in range(self.n)]
-        deductions = [coeff[0] * ca.fabs(torques[0])]
-        for k in range(1, self.n):
-            deductions.append(deductions[-1] + coeff[k] * (ca.fabs(torques[k - 1]) + ca.fabs(torques[k])))
-        return deductions
+        return self.piston.seal_coefficient()
 
     # -- one mode -----------------------------------------------------------------------------
     def _build_mode(self, axial, rotation):
+        """The mode ``<axial>_<rotation>``: its equations, outputs and events."""
         s, film, n = self.scene, self.film, self.n
-        rate = {name: 0.0 for name in self.state_names}
-        out = {}
         p = self.pressure()
         w_in, w_out = self.speeds()
         w_clutch = self.clutch_side_speed(rotation)
@@ -247,73 +248,54 @@ class EngagementModel:
         T_cont = [film.contact_torque(hi, w_rel, direction) for hi in driving] + idle
         T_film = [tv + tc for tv, tc in zip(T_visc, T_cont)]
         capacity = sum(film.static_capacity(hi) for hi in driving)
-        seal_power = 0.0
-        hydraulic_power = 0.0
-        spline_power = 0.0
 
-        # Axial dynamics -------------------------------------------------------------------
-        dh = [0.0] * n
-        if self.has_piston:
-            v0 = self.state("v0")
-            c_seal = self.seal_coefficient()
-            x0 = self.piston_position(axial)
-            F_drive = self.drive_force(p, x0)
-            rate["x0"] = v0
-            seal_power = c_seal * v0**2
-            sign = -1.0 if s.variant("piston") == "spring_applied" else 1.0
-            hydraulic_power = sign * p * s.value("piston.area") * v0
+        # Axial dynamics: the piston alone while it travels freely, then the pack it presses
+        drive = self.piston.drive(self.state, axial, p, n, self.H0)
         if axial == "approach":
-            rate["v0"] = (F_drive - c_seal * v0) / s.value("piston.mass")
-            face_force = 0.0
-        elif self.masses:
-            v = [self.state(f"v_{i + 1}") for i in range(n)]
-            if self.has_piston:
-                v[0] = v0                       # plate 1 moves with the piston (v_1 is its copy)
-            v_next = v[1:] + [0.0]
-            dh = [vn - vi for vi, vn in zip(v, v_next)]                      # Bao Eq. 13
-            W = [Ki * (-dhi) + Si for Ki, dhi, Si in zip(K, dh, S)]
-            if self.has_piston:
-                m_front = s.value("piston.mass") + self.plate_masses[0]     # moving together, Bao Eq. 23
-                front = F_drive - c_seal * v0 - W[0]
-                rate["v0"] = front / m_front
-                rate["v_1"] = rate["v0"]
-                face_force = 0.0
-            else:
-                face_force = p * self._pack_area()
-                rate["v_1"] = (face_force - W[0]) / self.plate_masses[0]
-                hydraulic_power = face_force * v[0]
-            for i in range(1, n):
-                rate[f"v_{i + 1}"] = (W[i - 1] - W[i]) / self.plate_masses[i]   # Bao Eq. 23
+            pressing = Pressing([0.0] * n, drive.free_travel(), 0.0, drive.hydraulic_power(0.0, 0.0))
         else:
-            d = self._spline_deductions(T_film)
-            if self.has_piston:
-                # Massless plates: the piston speed fixes the sum of film rates, which sets the
-                # force on the pack face: v0 = sum (F_face - d_k - S_k) / K_k.
-                face_force = (v0 + sum((dk + Sk) / Kk for dk, Sk, Kk in zip(d, S, K))) / sum(1 / Kk for Kk in K)
-                rate["v0"] = (F_drive - c_seal * v0 - face_force) / s.value("piston.mass")
-            else:
-                face_force = p * self._pack_area()
-            force = [face_force - dk for dk in d]
-            dh = [-(Fk - Sk) / Kk for Fk, Sk, Kk in zip(force, S, K)]
-            # Work of the face force not passed on to the films is lost in the splines.
-            spline_power = sum((face_force - Fk) * (-dhi) for Fk, dhi in zip(force, dh))
-            if not self.has_piston:
-                hydraulic_power = face_force * sum(-dhi for dhi in dh)
+            pressing = self.pack.press(self.state, drive, K, S, T_film)
+        rate = {name: 0.0 for name in self.state_names}
+        rate.update(drive.rates)
+        rate.update(pressing.rates)
         for i in range(n):
-            rate[f"h_{i + 1}"] = dh[i]
+            rate[f"h_{i + 1}"] = pressing.dh[i]
         if self.actuation.has_state:
             rate["p_valve"] = self.actuation.state_rate(self.t, self.state("p_valve"))
+        turning = self._rotation(rotation, T_film, w_in, w_out, w_clutch)
+        rate.update(turning.rates)
+        rate.update(self._energy_rates(rotation, h, K, S, pressing, drive, turning, w_in, w_out, w_rel))
+        heat_power = rate["E_slip"] + rate["E_film"]          # released at the friction interfaces
+        rate.update(self.thermal.rates(heat_power))
 
-        # Rotation -------------------------------------------------------------------------
+        alg = turning.alg
+        x_dict = {name: self.state(name) for name in self.state_names}
+        z_dict = {"w_hub": self.w_hub} if alg else None
+        jerk = time_derivative(ca.SX(turning.a_out), x_dict, [rate[name] for name in self.state_names],
+                               z=z_dict, alg=alg or None, t=self.t)
+        out = self._outputs(rotation, p, h, K, S, (w_in, w_out, w_clutch), (T_visc, T_cont, capacity),
+                            pressing, drive, turning, rate, heat_power, jerk)
+        events = self._events(axial, rotation, direction, w_rel, capacity)
+        torque_scale = max(abs(s.value("driveline.input_torque")), 10.0)
+        w_scale = max(s.value("driveline.input_speed"), s.value("driveline.output_speed"), 1.0)
+        return Mode(f"{axial}_{rotation}", x_dict, [rate[name] for name in self.state_names],
+                    z=z_dict, alg=alg, outputs=out, events=events,
+                    x_nominal=dict(zip(self.state_names, self.nominal)),
+                    z_nominal={"w_hub": w_scale} if alg else None, alg_nominal=[torque_scale] if alg else None,
+                    z_guess={"w_hub": s.value("driveline.output_speed")} if alg else None)
+
+    def _rotation(self, rotation, T_film, w_in, w_out, w_clutch):
+        """Torques and accelerations of the driveline in ``rotation`` (slipping or locked)."""
+        s = self.scene
         T_in = s.value("driveline.input_torque") if self.input_inertia else 0.0
         T_load = self.load_torque(w_out) if self.output_inertia else 0.0
         I_in = s.get("driveline.input_inertia")
         I_out = s.get("driveline.output_inertia")
-        alg, shaft_power = [], 0.0
+        alg, shaft_power, T_shaft, rates = [], 0.0, None, {}
         if self.compliant:
             c_shaft = s.value("driveline.shaft_damping")
             T_shaft = self.shaft_stiffness * self.state("theta_shaft") + c_shaft * (w_clutch - w_out)
-            rate["theta_shaft"] = w_clutch - w_out
+            rates["theta_shaft"] = w_clutch - w_out
             shaft_power = c_shaft * (w_clutch - w_out) ** 2
             if rotation == "locked":
                 T_clutch = T_shaft                         # hub locked to the input
@@ -336,35 +318,36 @@ class EngagementModel:
             a_in = (T_in - T_clutch) / I_in if self.input_inertia else 0.0
             a_out = (T_clutch - T_load) / I_out if self.output_inertia else 0.0
         if self.input_inertia:
-            rate["w_in"] = a_in
+            rates["w_in"] = a_in
         if self.output_inertia:
-            rate["w_out"] = a_out
+            rates["w_out"] = a_out
+        return Turning(T_in, T_load, T_clutch, a_out, alg, shaft_power, T_shaft, rates)
 
-        # Energy accumulators (work in = kinetic + stored + dissipated) --------------------------
-        source_power = T_in * w_in if self.input_inertia else T_clutch * w_in
+    def _energy_rates(self, rotation, h, K, S, pressing, drive, turning, w_in, w_out, w_rel):
+        """Rates of the energy accumulators (work in = kinetic + stored + dissipated) [W]."""
+        film, dh = self.film, pressing.dh
+        source_power = turning.T_in * w_in if self.input_inertia else turning.T_clutch * w_in
         film_fluid_power = sum((Ki * (-dhi) + Si - film.contact_force(hi)) * (-dhi)
                                for Ki, Si, dhi, hi in zip(K, S, dh, h))
         contact_power = sum(film.contact_force(hi) * (-dhi) for hi, dhi in zip(h, dh))
-        rate["E_source"] = source_power
-        rate["E_hydraulic"] = hydraulic_power
-        rate["E_load"] = T_load * w_out
-        rate["E_slip"] = T_clutch * w_rel if rotation != "locked" else 0.0
-        rate["E_film"] = film_fluid_power
-        rate["E_contact"] = contact_power
-        rate["E_seal"] = seal_power
-        rate["E_spline"] = spline_power
-        rate["E_shaft"] = shaft_power
-        rate["E_impact"] = 0.0
-        heat_power = rate["E_slip"] + film_fluid_power          # released at the friction interfaces
-        rate.update(self.thermal.rates(heat_power))
-        ode = ca.vertcat(*[rate[name] for name in self.state_names])
+        return {"E_source": source_power,
+                "E_hydraulic": pressing.hydraulic_power,
+                "E_load": turning.T_load * w_out,
+                "E_slip": turning.T_clutch * w_rel if rotation != "locked" else 0.0,
+                "E_film": film_fluid_power,
+                "E_contact": contact_power,
+                "E_seal": drive.seal_power,
+                "E_spline": pressing.spline_power,
+                "E_shaft": turning.shaft_power,
+                "E_impact": 0.0}
 
-        # Outputs ------------------------------------------------------------------------------
-        x_dict = {name: self.state(name) for name in self.state_names}
-        z_dict = {"w_hub": self.w_hub} if alg else None
-        jerk = time_derivative(ca.SX(a_out), x_dict, [rate[name] for name in self.state_names],
-                               z=z_dict, alg=alg or None, t=self.t)
-        out["pressure_Pa"] = p
+    def _outputs(self, rotation, p, h, K, S, speeds, torques, pressing, drive, turning, rate, heat_power, jerk):
+        """Named outputs of a mode (every column of the time series besides the states)."""
+        film, n, dh = self.film, self.n, pressing.dh
+        w_in, w_out, w_clutch = speeds
+        T_visc, T_cont, capacity = torques
+        T_clutch = turning.T_clutch
+        out = {"pressure_Pa": p}
         for i in range(n):
             out[f"h_{i + 1}_m"] = h[i]
         out.update(self._positions(h))
@@ -372,7 +355,7 @@ class EngagementModel:
         out["w_out_rad_s"] = w_out
         if self.compliant:
             out["w_hub_rad_s"] = w_clutch
-            out["shaft_torque_Nm"] = T_shaft
+            out["shaft_torque_Nm"] = turning.T_shaft
         out["viscous_torque_Nm"] = sum(T_visc) if rotation != "locked" else 0.0
         out["contact_torque_Nm"] = sum(T_cont) if rotation != "locked" else T_clutch
         out["total_torque_Nm"] = T_clutch
@@ -383,27 +366,19 @@ class EngagementModel:
             # closing speed; int sum(force x speed) dt is E_film, so the CSV alone closes the balance
             out[f"film_{i + 1}_fluid_force_N"] = K[i] * (-dh[i]) + S[i] - film.contact_force(h[i])
             out[f"film_{i + 1}_closing_speed_m_s"] = -dh[i]
-        out["pack_force_N"] = face_force
-        if self.has_piston:
-            out["piston_force_N"] = F_drive          # springs and pressure on the piston (net drive)
-        out["output_acceleration_rad_s2"] = a_out
+        out["pack_force_N"] = pressing.face_force
+        out.update(drive.outputs())
+        out["output_acceleration_rad_s2"] = turning.a_out
         out["output_jerk_rad_s3"] = jerk
-        out["dissipated_power_W"] = rate["E_slip"] + film_fluid_power + seal_power + spline_power + shaft_power
+        out["dissipated_power_W"] = (rate["E_slip"] + rate["E_film"] + drive.seal_power + pressing.spline_power
+                                     + turning.shaft_power)
         out["interface_heat_power_W"] = heat_power
         out.update(self.thermal.outputs())
         out["kinetic_energy_J"] = self._kinetic_energy()
-        out["spring_energy_J"] = self.spring_energy(x0) if self.has_piston else 0.0
+        out["spring_energy_J"] = drive.spring_energy
         if self.compliant:
             out["spring_energy_J"] += 0.5 * self.shaft_stiffness * self.state("theta_shaft") ** 2
-
-        events = self._events(axial, rotation, direction, w_rel, capacity)
-        torque_scale = max(abs(s.value("driveline.input_torque")), 10.0)
-        w_scale = max(s.value("driveline.input_speed"), s.value("driveline.output_speed"), 1.0)
-        return Mode(f"{axial}_{rotation}", x_dict, [rate[name] for name in self.state_names],
-                    z=z_dict, alg=alg, outputs=out, events=events,
-                    x_nominal=dict(zip(self.state_names, self.nominal)),
-                    z_nominal={"w_hub": w_scale} if alg else None, alg_nominal=[torque_scale] if alg else None,
-                    z_guess={"w_hub": s.value("driveline.output_speed")} if alg else None)
+        return out
 
     def clutch_side_speed(self, rotation):
         """Speed of the clutch plates on the output side [rad/s]: the output speed, or with a
@@ -433,15 +408,7 @@ class EngagementModel:
         events = []
         torque_scale = max(abs(self.scene.get("driveline.input_torque", 0.0)), 10.0)
         if axial == "approach":
-            reset = None
-            if self.masses:
-                m0, m1 = self.scene.value("piston.mass"), self.plate_masses[0]
-                v0 = self.state("v0")
-                v_after = m0 * v0 / (m0 + m1)                                 # Bao Eq. 22
-                loss = 0.5 * m0 * v0**2 - 0.5 * (m0 + m1) * v_after**2
-                reset = {"v0": v_after, "v_1": v_after, "E_impact": self.state("E_impact") + loss}
-            events.append(Event("impact", self.travel - self.state("x0"), f"pressing_{rotation}",
-                                direction=-1, reset=reset, scale=max(self.travel, self.H0)))
+            events.append(self.piston.impact_event(self.state, rotation, self.pack, self.H0))
         needed = self.locked_torque()
         margin = capacity - ca.fabs(needed)
         if rotation == "locked":
@@ -500,11 +467,8 @@ class EngagementModel:
             ke += 0.5 * s.value("driveline.input_inertia") * w_in**2
         if self.output_inertia:
             ke += 0.5 * s.value("driveline.output_inertia") * w_out**2
-        if self.has_piston:
-            ke += 0.5 * s.value("piston.mass") * self.state("v0") ** 2
-        if self.masses:
-            for i in range(self.n):
-                ke += 0.5 * self.plate_masses[i] * self.state(f"v_{i + 1}") ** 2
+        for term in self.piston.kinetic_energy_terms(self.state) + self.pack.kinetic_energy_terms(self.state):
+            ke += term
         return ke
 
     # -- mode logic -------------------------------------------------------------------------

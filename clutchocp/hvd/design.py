@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import control
 import numpy as np
 
+from ..control.lqr import lqi
 from ..errors import ModelError
 from .controller import ScheduledController
 from .linearize import SPEED_OUTPUT, describe, linearize
@@ -149,41 +150,6 @@ def design(model, spec, map_data=None):
 def state_scales(model, p_lo, p_hi):
     """Deviation scales of the states (rated speed, pressure range, film scale) for the weights."""
     return np.array([model.rated_speed, p_hi - p_lo] + [model.film_scale] * model.n_states_film)
-
-
-def lqr_gain(A, B, Q, R):
-    """Discrete LQR state-feedback gain K (u = -K x) minimising sum x'Qx + u'Ru (python-control dlqr)."""
-    try:
-        K, _, _ = control.dlqr(np.atleast_2d(A), np.atleast_2d(B), np.atleast_2d(Q), np.atleast_2d(R))
-    except (np.linalg.LinAlgError, ValueError) as exc:
-        raise ModelError(f"controller [lqi] weights: the LQR problem has no solution ({exc}); use weights of "
-                         "similar size (speed_weight, integral_weight, input_weight within 1e-6 ... 1e6)") from None
-    if not np.all(np.isfinite(K)):
-        raise ModelError("controller [lqi] weights: the LQR gain is not finite; use weights of similar size")
-    return np.atleast_2d(np.asarray(K))
-
-
-def lqi(Ad, Bd, Ts, Q, R):
-    """Discrete LQR with integral action on the first state (the speed).
-
-    The plant x[k+1] = Ad x + Bd u is augmented with xi[k+1] = xi[k] + Ts (r - x_1[k]) and
-    ``lqr_gain`` is applied with the (n+1)x(n+1) weight Q and the input weight R.
-
-    Returns
-    -------
-    K_x : (n,) gains on the state deviation; k_i : integral gain (I[k+1] = I[k] + Ts k_i e);
-    loop : discrete loop transfer K (zI - A_aug)^-1 B_aug broken at the plant input.
-    """
-    Ad, Bd = np.atleast_2d(Ad), np.atleast_2d(Bd)
-    n = Ad.shape[0]
-    C = np.zeros((1, n))
-    C[0, 0] = 1.0
-    A_aug = np.block([[Ad, np.zeros((n, 1))], [-Ts * C, np.ones((1, 1))]])
-    B_aug = np.vstack([Bd, [[0.0]]])
-    K = lqr_gain(A_aug, B_aug, Q, R).ravel()
-    loop = control.ss(A_aug, B_aug, K.reshape(1, -1), 0, dt=Ts)
-    # u = -K_x dx - K_xi xi and xi integrates e = r - w, so I = -K_xi xi and k_i = -K_xi
-    return K[:n], -K[n], loop
 
 
 def _lqi(model, spec, plant_d, p_lo, p_hi):

@@ -1,18 +1,14 @@
 """Exact linearisation of the HVD DAE at an operating point, as a python-control state space.
 
-With dx/dt = f(x, z, u), 0 = g(x, z, u) (g_z non-singular) and outputs y = c(x, z, u), the
-implicit function theorem gives dz = -g_z^-1 (g_x dx + g_u du), so
-
-    A = f_x - f_z g_z^-1 g_x,   B = f_u - f_z g_z^-1 g_u,
-    C = c_x - c_z g_z^-1 g_x,   D = c_u - c_z g_z^-1 g_u,
-
-all Jacobians evaluated exactly by CasADi (algorithmic differentiation) at the point.
+The Jacobians are CasADi's, the algebraic variables eliminated (:mod:`clutchocp.control.linearize`):
+A = f_x - f_z g_z^-1 g_x, B = f_u - f_z g_z^-1 g_u, C = c_x - c_z g_z^-1 g_x, D = c_u - c_z g_z^-1 g_u.
 """
 
 import casadi as ca
 import control
 import numpy as np
 
+from ..control.linearize import jacobian_function, linear_model
 from ..errors import ModelError
 
 #: Output used for speed control.
@@ -25,10 +21,7 @@ def _jacobian_function(model, outputs):
     if key not in cache:
         xv, zv, uv = model.vector("x"), model.vector("z"), model.vector("u")
         c = ca.vertcat(*[model.outputs[n] for n in outputs])
-        blocks = []
-        for expr in (model.ode, model.alg, c):
-            blocks += [ca.jacobian(expr, xv), ca.jacobian(expr, zv), ca.jacobian(expr, uv)]
-        cache[key] = ca.Function("hvd_jacobians", [xv, zv, uv], blocks)
+        cache[key] = jacobian_function("hvd_jacobians", [xv, zv, uv], xv, zv, uv, model.ode, model.alg, c)
     return cache[key]
 
 
@@ -53,41 +46,9 @@ def linearize(model, point, outputs=(SPEED_OUTPUT,)):
     unknown = [n for n in outputs if n not in model.outputs]
     if unknown:
         raise ModelError(f"outputs {unknown} are not outputs of the HVD model; known: {list(model.outputs)}")
-    jac = _jacobian_function(model, outputs)
-    fx, fz, fu, gx, gz, gu, cx, cz, cu = (np.array(m, dtype=float) for m in jac(point.x, point.z, point.u))
-    (A, B), (C, D) = eliminate_algebraic(gx, gz, gu, (fx, fz, fu), (cx, cz, cu))
+    A, B, C, D = linear_model(_jacobian_function(model, outputs), point.x, point.z, point.u)
     return control.ss(A, B, C, D, inputs=list(model.u), outputs=list(outputs), states=list(model.x),
                       name=f"hvd_{model.scene.name}")
-
-
-def eliminate_algebraic(gx, gz, gu, *blocks):
-    """Jacobians with the algebraic variables eliminated (implicit function theorem).
-
-    With 0 = g(x, z, u) and g_z non-singular, dz = -g_z^-1 (g_x dx + g_u du), so an expression
-    h(x, z, u) has the total Jacobians H_x = h_x - h_z g_z^-1 g_x and H_u = h_u - h_z g_z^-1 g_u.
-
-    Parameters
-    ----------
-    gx, gz, gu : numpy.ndarray
-        Jacobians of the algebraic residuals (gz square; empty if there are none).
-    *blocks : (hx, hz, hu) tuples of numpy.ndarray
-        Jacobians of each expression to reduce (the ODE right-hand side, outputs ...).
-
-    Returns
-    -------
-    list of (H_x, H_u), one per block.
-
-    Raises
-    ------
-    ModelError
-        g_z is singular (the DAE is not index 1 at this point).
-    """
-    if not gz.size:
-        return [(hx, hu) for hx, _, hu in blocks]
-    if np.linalg.cond(gz) > 1e14:
-        raise ModelError("linearisation: d alg / d z is singular at this point (the DAE is not index 1 here)")
-    solve_x, solve_u = np.linalg.solve(gz, gx), np.linalg.solve(gz, gu)
-    return [(hx - hz @ solve_x, hu - hz @ solve_u) for hx, hz, hu in blocks]
 
 
 def reduced_rhs(model, x, u):

@@ -29,21 +29,14 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import (
-    MissingParameterError,
-    ParameterTypeError,
-    PhysicalRangeError,
-    SceneError,
-    UnknownKeyError,
-    UnknownVariantError,
-)
-from ..scene.loader import _suggest, builtin_dir, read_toml
-from ..units import to_si
+from ..control.spec import check_tables, parse_table, read_spec
+from ..errors import MissingParameterError, PhysicalRangeError, SceneError, UnknownKeyError
+from ..scene.loader import builtin_dir
 
 TYPES = ("lqi", "pi")
 ANTI_WINDUP = ("back_calculation", "clamping", "none")
 
-# table -> key -> (dimension, check or choices, default); checks: see _CHECKS
+# table -> key -> (dimension, check or choices, default); see clutchocp.control.spec
 _CONTROLLER = {
     "name": ("str", None, ""),
     "type": ("choice", TYPES, None),
@@ -81,21 +74,7 @@ _SCENARIO = {
     "load_step": ("1", "fraction", 0.2),
 }
 _TABLES = {"controller": _CONTROLLER, "lqi": _LQI, "pi": _PI, "anti_windup": _ANTI_WINDUP, "scenario": _SCENARIO}
-_CHECKS = {
-    "positive": (lambda v: v > 0, "> 0"),
-    "nonnegative": (lambda v: v >= 0, ">= 0"),
-    "fraction": (lambda v: 0 < v < 1, "in (0, 1)"),
-    "angle": (lambda v: 0 < v < math.pi / 2, "in (0, 90) deg"),
-    "above_one": (lambda v: v > 1, "> 1"),
-    # LQI weights act on states scaled to about 1; beyond a ratio of 1e12 between two weights the
-    # Riccati equation cannot be solved in double precision (integral_weight = 1e300 failed in LAPACK)
-    "weight": (lambda v: 0 <= v <= 1e6, "in [0, 1e6] (weights on scaled states; larger ones make the LQR "
-                                        "problem numerically singular)"),
-    "positive_weight": (lambda v: 1e-6 <= v <= 1e6, "in [1e-6, 1e6] (weights on scaled states; others make "
-                                                    "the LQR problem numerically singular)"),
-}
-
-
+_REQUIRED = ("type", "sample_time", "schedule")
 @dataclass
 class ControllerSpec:
     """A validated controller specification (SI units, speeds as fractions of the rated speed)."""
@@ -139,30 +118,13 @@ def load_controller(name_or_path):
     return read_spec(name_or_path, parse_controller)
 
 
-def read_spec(name_or_path, parse):
-    """Read a spec file of controllers/ (built-in name or path) and validate it with ``parse``.
-
-    Errors name the file; the returned spec keeps its ``path``.
-    """
-    path, raw = read_toml(name_or_path, "controllers", "controller spec")
-    try:
-        spec = parse(raw)
-    except SceneError as exc:
-        raise type(exc)(f"{path.name}: {exc}") from None
-    spec.path = path
-    return spec
-
-
 def parse_controller(raw):
     """Validate a parsed controller spec (a dict of TOML tables); return a :class:`ControllerSpec`."""
-    if not isinstance(raw, dict):
-        raise ParameterTypeError("controller spec: expected TOML tables")
-    for table in raw:
-        if table not in _TABLES:
-            raise UnknownKeyError(f"[{table}]: unknown table{_suggest(table, _TABLES)} (allowed: {', '.join(_TABLES)})")
+    check_tables(raw, _TABLES, "controller spec")
     if "controller" not in raw:
         raise MissingParameterError("[controller]: missing table (type, sample_time and schedule are required)")
-    values = {name: _table(name, raw.get(name, {}), schema) for name, schema in _TABLES.items()}
+    values = {name: parse_table(name, raw.get(name, {}), schema, _REQUIRED if name == "controller" else ())
+              for name, schema in _TABLES.items()}
     c = values["controller"]
     other = "pi" if c["type"] == "lqi" else "lqi"
     if other in raw:
@@ -181,55 +143,3 @@ def parse_controller(raw):
                           feedforward=c["feedforward"],
                           pressure_min=c["pressure_min"], pressure_max=c["pressure_max"],
                           lqi=values["lqi"], pi=values["pi"], anti_windup=aw, scenario=values["scenario"])
-
-
-def _table(name, table, schema):
-    if not isinstance(table, dict):
-        raise ParameterTypeError(f"[{name}]: expected a table of parameters, got {table!r}")
-    for key in table:
-        if key not in schema:
-            raise UnknownKeyError(f"{name}.{key}: unknown key in [{name}]{_suggest(key, schema)} "
-                                  f"(allowed: {', '.join(schema)})")
-    out = {}
-    for key, (dim, check, default) in schema.items():
-        field_name = f"{name}.{key}"
-        if key not in table:
-            if default is None and name == "controller" and key in ("type", "sample_time", "schedule"):
-                raise MissingParameterError(f"{field_name}: missing required parameter")
-            out[key] = default
-            continue
-        out[key] = _value(field_name, table[key], dim, check)
-    return out
-
-
-def _value(name, raw, dim, check):
-    if dim == "str":
-        if not isinstance(raw, str):
-            raise ParameterTypeError(f"{name}: expected text, got {raw!r}")
-        return raw
-    if dim == "bool":
-        if not isinstance(raw, bool):
-            raise ParameterTypeError(f"{name}: expected true or false, got {raw!r}")
-        return raw
-    if dim == "choice":
-        if raw not in check:
-            raise UnknownVariantError(f"{name} = {raw!r}: allowed values are {', '.join(check)}"
-                                      + (_suggest(raw, check) if isinstance(raw, str) else ""))
-        return raw
-    if dim == "fractions":
-        if not isinstance(raw, list) or not raw:
-            raise ParameterTypeError(f"{name}: expected a list of fractions of the rated speed, e.g. [0.4, 0.6, 0.9]")
-        return tuple(_number(f"{name}[{i}]", v, "1", check) for i, v in enumerate(raw))
-    return _number(name, raw, dim, check)
-
-
-def _number(name, raw, dim, check):
-    if isinstance(raw, (bool, list, dict)):
-        raise ParameterTypeError(f"{name}: expected a number, got {raw!r}")
-    value = to_si(raw, dim, name)
-    if not math.isfinite(value):
-        raise PhysicalRangeError(f"{name} = {value}: must be a finite number")
-    ok, phrase = _CHECKS[check]
-    if not ok(value):
-        raise PhysicalRangeError(f"{name} = {raw!r}: must be {phrase}")
-    return value

@@ -7,8 +7,10 @@ baseline is a command under the optimum's own pressure and rate limits (:func:`t
 """
 
 import numpy as np
+from scipy.optimize import minimize
 
 from ..engagement.run import simulate_engagement
+from .replay import CommandModel, simulate_command
 from .verify import JUMP_TOLERANCE, run_numbers
 
 LAG_TIMES = (0.02, 0.04, 0.06, 0.08, 0.1)      # Zhang 2021's range of t_s [s]
@@ -96,7 +98,7 @@ def fill_pulse_command(pulse_pressure, pulse_time, hold_pressure, hold_time, ram
 
 
 def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=JUMP_TOLERANCE, max_evaluations=60,
-                    progress=None):
+                    progress=None, model=None):
     """The "fill pulse, hold, ramp" command that locks up soonest with peak jerk <= ``jerk_cap`` and
     a lock-up jump within ``jump_limit`` of the locked torque (the conditions the optimum meets).
 
@@ -122,6 +124,8 @@ def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=J
         IDAS runs allowed to the search.
     progress : callable, optional
         Called with a line per 10 evaluations.
+    model : clutchocp.optimal.replay.CommandModel, optional
+        The piecewise-linear command model of ``scene`` already built.
 
     Returns
     -------
@@ -129,11 +133,7 @@ def tune_fill_pulse(scene, *, jerk_cap, p_max, rate_limit, t_scale, jump_limit=J
         ``parameters`` (FILL_PULSE_KEYS), ``times``/``command`` (the nodes), ``numbers`` (run_numbers
         of its IDAS run), ``run`` and ``evaluations``.
     """
-    from scipy.optimize import minimize
-
-    from .replay import CommandModel, simulate_command
-
-    model = CommandModel(scene, "linear")
+    model = CommandModel(scene, "linear") if model is None else model
     p0 = scene.value("actuation.initial_pressure")
     cache = {}
 

@@ -66,6 +66,13 @@ class ClampedCommand:
     def __iter__(self):
         return iter((self.times, self.pressures))
 
+    @property
+    def basis(self):
+        """How the clamp pressure was chosen (for progress lines and legends)."""
+        if self.margin is None:
+            return "holding pressure: the lock carries no torque"
+        return f"capacity {self.margin:g} x the locked torque"
+
 
 class ClampModel:
     """Static capacity of a scene's pack against the settled command pressure, and the locked torque.
@@ -76,38 +83,43 @@ class ClampModel:
         An engagement scene with a massless pack (``pack.model = "massless"``). With a piston the
         settled pack also has the piston at rest on it (v0 = 0, its acceleration zero: pressure force
         minus return spring equals the face force).
+    model, command : EngagementModel, casadi.SX, optional
+        The exact model of ``scene`` already built with ``pressure_command=command`` (default: built here).
     """
 
-    def __init__(self, scene):
+    def __init__(self, scene, model=None, command=None):
         if scene.variant("pack") != "massless":
             raise ModelError("clamp pressure: computed for a massless pack (pack.model = 'massless')")
-        u = ca.SX.sym("command")
-        self.model = model = EngagementModel(scene, smooth=False, pressure_command=u)
+        if model is None:
+            command = ca.SX.sym("command")
+            model = EngagementModel(scene, smooth=False, pressure_command=command)
+        u = command
+        self.model = model
         mode = model.modes[LOCKED_MODE]
         self.films = [model.index[f"h_{i + 1}"] for i in range(model.n)]
         x = model.x
         if model.actuation.has_state:            # settled valve: its pressure is the command
             x = ca.substitute(x, model.state("p_valve"), u)
         rates = ca.vertcat(*[mode.ode[i] for i in self.films])
-        if model.has_piston:
+        self.x_lock = model.initial_state.copy()
+        w_lock = scene.value("driveline.output_speed")       # both sides at the output speed
+        for name in ("w_in", "w_out"):
+            if name in model.index:
+                self.x_lock[model.index[name]] = w_lock
+        self.piston = model.has_piston
+        if self.piston:
             # the piston at rest: with v0 = 0 the film rates of equal films vanish for any thickness,
             # and its acceleration (pressure force - return spring - face force) / m is what settles;
             # scaled to a force fraction of the largest pressure force
             i_v0 = model.index["v0"]
             force = scene.value("piston.mass") / (scene.value("piston.area") * scene.get("actuation.max_pressure", 1e6))
             rates = ca.vertcat(mode.ode[i_v0] * force * (model.H0 / 0.01), rates)
-        self.piston = model.has_piston
+            self.x_lock[i_v0] = 0.0
+        self.n_rates = rates.numel()                     # the residual rows; then capacity and pressure
         outputs = [mode.outputs["static_capacity_Nm"], mode.outputs["pressure_Pa"]]
         self._fn = ca.Function("clamp", [model.x, u], [ca.substitute(ca.vertcat(rates, *outputs), model.x, x)])
         self._locked = ca.Function("locked", [model.x], [model.locked_torque()])
-        self.x_lock = model.initial_state.copy()
-        w_lock = scene.value("driveline.output_speed")       # both sides at the output speed
-        for name in ("w_in", "w_out"):
-            if name in model.index:
-                self.x_lock[model.index[name]] = w_lock
         self.p_max = scene.get("actuation.max_pressure")
-        if model.has_piston:
-            self.x_lock[model.index["v0"]] = 0.0
 
     def locked_torque(self, state=None):
         """Torque the locked driveline carries [N m] (at ``state``, default: both sides at the output speed)."""
@@ -117,8 +129,7 @@ class ClampModel:
         """Film thicknesses [m] at which every film rate vanishes under the command ``pressure`` [Pa]."""
         model = self.model
         H0 = model.H0
-
-        n_rates = len(self.films) + self.piston
+        n_rates = self.n_rates
 
         def residual(h):
             x = self.x_lock.copy()
@@ -143,7 +154,7 @@ class ClampModel:
         """Static capacity [N m] of the settled pack under the command ``pressure`` [Pa]."""
         x = self.x_lock.copy()
         x[self.films] = self.settled_films(pressure)
-        return float(np.array(self._fn(x, pressure)).ravel()[len(self.films) + self.piston])
+        return float(np.array(self._fn(x, pressure)).ravel()[self.n_rates])
 
     def clamp_pressure(self, margin=DEFAULT_MARGIN, locked_torque=None):
         """Command pressure [Pa] whose settled capacity is ``margin`` x the locked torque.
@@ -175,7 +186,7 @@ class ClampModel:
 
 
 def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MARGIN, rate_limit=None,
-                    locked_torque=None, clamp_pressure=None):
+                    locked_torque=None, clamp_pressure=None, model=None):
     """The engagement command up to lock-up continued by a ramp to the clamp pressure.
 
     Parameters
@@ -195,6 +206,8 @@ def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MAR
         The pressure to ramp to [Pa], given instead of sized by ``margin``: for a lock that carries no
         torque (a brake with its output held, a prescribed input speed without load), which no
         capacity margin can size; the ClampedCommand's margin is then None.
+    model : ClampModel, optional
+        The clamp model of ``scene`` already built.
 
     Returns
     -------
@@ -209,7 +222,7 @@ def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MAR
     if not (np.isfinite(t_lock) and times[0] < t_lock):
         raise ModelError(f"t_lock = {t_lock!r}: must be a time after the command starts [s]")
     if clamp_pressure is None:
-        clamp = ClampModel(scene)
+        clamp = ClampModel(scene) if model is None else model
         p_c, p_max = clamp.clamp_pressure(margin, locked_torque), clamp.p_max
         demand = abs(clamp.locked_torque() if locked_torque is None else float(locked_torque))
     else:           # nothing to size: no clamp model (any pack)

@@ -191,7 +191,67 @@ class TranscribedNLP:
         return self.transcription.node_times(T)
 
 
-class DirectCollocation:
+class CollocationScheme:
+    """What every collocation transcription shares: the points and matrices of one scheme and the rows
+    they give on a run of intervals (collocation equations, continuity, quadrature).
+
+    A transcription decides its variables and the step of each interval and builds its NLP from these
+    rows (as Dymos keeps its transcriptions under one base class): :class:`DirectCollocation` (one phase
+    of free duration on a mesh) and
+    :class:`~clutchocp.optimal.scenarios.SharedCommandCollocation` (several scenarios under one
+    command on a common grid, the robust problem).
+
+    Parameters
+    ----------
+    degree : int
+        Collocation points per interval d.
+    scheme : {"radau", "legendre"}
+        Radau IIA (default) or Gauss-Legendre points.
+    """
+
+    def __init__(self, degree=3, scheme="radau"):
+        self.degree = int(degree)
+        self.scheme = scheme
+        self.tau, self.C, self.D, self.B = collocation_coefficients(self.degree, scheme)
+
+    def collocation_rows(self, X, Xc, h, xdot):
+        """The collocation equations sum_r C[r, j] x_r = h xdot_j (x_0 the interval start) of N intervals.
+
+        Parameters
+        ----------
+        X : casadi.MX (n_x, N + 1)
+            States at the interval starts (and the end).
+        Xc : casadi.MX (n_x, N d)
+            States at the collocation points.
+        h : casadi.MX (1, N d)
+            Step of each point's interval.
+        xdot : casadi.MX (n_x, N d)
+            State derivatives at the collocation points.
+
+        Returns
+        -------
+        (casadi.MX, casadi.MX)
+            The linear part sum_r C[r, j] x_r and the residual (linear part - h xdot), both (n_x, N d).
+        """
+        N, d, n_x = X.size2() - 1, self.degree, X.size1()
+        C0 = np.tile(self.C[0], N)[None, :]                         # weight of the interval start
+        linear = repeat_columns(X[:, :-1], d) * ca.DM(np.repeat(C0, n_x, axis=0))
+        linear = linear + ca.mtimes(Xc, sparse_dm(sparse.kron(sparse.eye(N), self.C[1:])))   # (N d, N d) blocks
+        return linear, linear - ca.repmat(h, n_x, 1) * xdot
+
+    def continuity_rows(self, X, Xc):
+        """x_k+1 - x(1) of each interval k, x(1) = sum_r D[r] x_r its polynomial at the end (n_x, N)."""
+        N = X.size2() - 1
+        ends = X[:, :-1] * self.D[0] + ca.mtimes(Xc, sparse_dm(sparse.kron(sparse.eye(N), self.D[1:, None])))
+        return X[:, 1:] - ends
+
+    def quadrature(self, q, h):
+        """Integrals of the integrands ``q`` (n_q, N d) at the collocation points with steps ``h`` (1, N d)."""
+        N = q.size2() // self.degree
+        return ca.mtimes(q * ca.repmat(h, q.size1(), 1), ca.DM(np.tile(self.B, N)))
+
+
+class DirectCollocation(CollocationScheme):
     """Direct collocation transcription of a :class:`StagedProblem`.
 
     Parameters
@@ -215,10 +275,8 @@ class DirectCollocation:
         if control not in CONTROLS:
             raise ModelError(f"control '{control}': allowed values are {', '.join(CONTROLS)}")
         self.intervals = int(intervals)
-        self.degree = int(degree)
-        self.scheme = scheme
         self.control = control
-        self.tau, self.C, self.D, self.B = collocation_coefficients(self.degree, scheme)
+        super().__init__(degree, scheme)
         if mesh is None:
             self.mesh = np.full(self.intervals, 1.0 / self.intervals)
             self.uniform = True
@@ -269,9 +327,9 @@ class DirectCollocation:
         """Control at the collocation points from the control values (columns), as (n_u, N*d)."""
         N, d = self.intervals, self.degree
         if self.control == "constant":
-            return _repeat_columns(U, d)
-        left = _repeat_columns(U[:, :-1], d)
-        right = _repeat_columns(U[:, 1:], d)
+            return repeat_columns(U, d)
+        left = repeat_columns(U[:, :-1], d)
+        right = repeat_columns(U[:, 1:], d)
         weight = np.tile(self.tau, N)[None, :]
         return left + (right - left) * ca.DM(np.repeat(weight, U.size1(), axis=0))
 
@@ -298,20 +356,12 @@ class DirectCollocation:
 
         Uc = self.control_at_points(U)
         xdot, q, c = problem.dynamics.map(N * d)(Xc, Uc, ca.repmat(P, 1, N * d))
-        h = _repeat_columns(Tk, d) / N                               # step of each point's interval
+        h = repeat_columns(Tk, d) / N                               # step of each point's interval
         if not self.uniform:
             h = h * self._stretch_row(d)
-        # Collocation equations: sum_r C[r, j] x_r = h xdot_j with x_0 the interval start.
-        starts = _repeat_columns(X[:, :-1], d)
-        C0 = np.tile(self.C[0], N)[None, :]                         # weight of the interval start
-        colloc = starts * ca.DM(np.repeat(C0, n_x, axis=0))
-        Cin = _sparse(sparse.kron(sparse.eye(N), self.C[1:]))        # (N d, N d) block diagonal
-        colloc_linear = colloc + ca.mtimes(Xc, Cin)
-        colloc = colloc_linear - ca.repmat(h, n_x, 1) * xdot
-        ends = X[:, :-1] * self.D[0] + ca.mtimes(Xc, _sparse(sparse.kron(sparse.eye(N), self.D[1:, None])))
-        continuity = X[:, 1:] - ends
-        B = ca.DM(np.tile(self.B, N))
-        Q = ca.mtimes(q * ca.repmat(h, q.size1(), 1), B)             # integrals over [0, T]
+        colloc_linear, colloc = self.collocation_rows(X, Xc, h, xdot)
+        continuity = self.continuity_rows(X, Xc)
+        Q = self.quadrature(q, h)                                     # integrals over [0, T]
         T = Tk[-1]
         J = problem.objective(X[:, -1], U[:, -1], Q, T, P)
         g_end = problem.end(X[:, -1], U[:, -1], T, P)
@@ -359,7 +409,7 @@ class DirectCollocation:
                               rows, self, problem, g_linear)
 
 
-def _sparse(matrix):
+def sparse_dm(matrix):
     """A CasADi DM with the sparsity of a scipy sparse matrix (a dense DM would make the Jacobian dense)."""
     m = sparse.csc_matrix(matrix)
     m.eliminate_zeros()
@@ -367,7 +417,7 @@ def _sparse(matrix):
     return ca.DM(pattern, m.data.tolist())
 
 
-def _repeat_columns(M, times):
+def repeat_columns(M, times):
     """Each column of M repeated ``times`` times, side by side (MX or DM)."""
     index = np.repeat(np.arange(M.size2()), times)
     return M[:, index.tolist()]

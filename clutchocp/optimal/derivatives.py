@@ -12,8 +12,8 @@ one collocation point (or from the end point). So the exact derivatives are asse
 * the Jacobian and Hessian of the end function and of the end part of the objective,
 
 scattered into the global sparse matrices by one constant sparse matrix product. The result is the
-same Jacobian and Hessian (checked against CasADi's own in tests/test_optimal_collocation.py and
-tests/test_optimal.py). Measured on the default problem (N = 100, degree 3): 2.7 ms per Jacobian
+same Jacobian and Hessian (checked against CasADi's own in tests/optimal/test_optimal_collocation.py and
+tests/optimal/test_optimal.py). Measured on the default problem (N = 100, degree 3): 2.7 ms per Jacobian
 and 23 ms per Hessian, against 16 ms and 54 ms by CasADi's AD of the graph (and 0.1 s / 0.3 s
 before equal films were merged into one state); expanding the whole NLP to SX instead took
 10 minutes and 14 GB to build.

@@ -20,7 +20,8 @@ import casadi as ca
 import numpy as np
 
 from ..errors import SolverError
-from .problem import OBJECTIVE_TERMS
+from .objective import OBJECTIVE_TERMS
+from .verify import verify
 
 ORDER_OVER_DEGREE = 1           # q = degree + 1
 DENSITY_FLOOR = 0.1             # rho >= DENSITY_FLOOR x its mean over the phase
@@ -147,7 +148,6 @@ def solve_verified(ocp, *, refinements=MAX_REFINEMENTS, command_model=None, say=
         verification's lock-time difference and jump share (None for the coarse start; a failed
         solve: ``{"stage": "graded mesh", "graded": True, "failed": message}``).
     """
-    from .verify import verify
     say = say or (lambda *a, **k: None)
     history = []
     coarse = None

@@ -1,7 +1,11 @@
-"""The result of :func:`clutchocp.optimize`: the optimum, its IDAS check and the baselines, at a glance."""
+"""The result of :func:`clutchocp.optimize`: the optimum, its IDAS check and the baselines, at a glance;
+the rows of its pressure profile."""
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
+from ..output import save_figure
 from ..simulation.result import Table
 
 
@@ -29,6 +33,9 @@ class OptimizationResult:
     fill : dict or None
         On a scene with a fill phase: the minimum-time optimum against the tuned "fill pulse, hold,
         ramp" baseline (``summary``, ``optimal_run``, ``baseline_run``); None otherwise.
+    figure : callable
+        ``figure(result) -> matplotlib.figure.Figure``: the pressure figure of :meth:`plot` (given by
+        the ``optimize`` workflow, :func:`clutchocp.optimal.figures.result_figure`).
     """
 
     scene: object
@@ -40,6 +47,7 @@ class OptimizationResult:
     fill: dict = None
     curve: object = None
     clamp_run: object = None
+    figure: object = field(default=None, repr=False)
 
     def __repr__(self):
         s = self.summary
@@ -57,7 +65,6 @@ class OptimizationResult:
     def table(self):
         """The whole pressure curve as in pressure_profile.csv: ``time_s``, ``pressure_command_Pa``,
         ``pressure_Pa``, ``phase``, ``to_next``."""
-        from .report import profile_columns
         return Table(profile_columns(self.optimum, self.curve, self.clamp_run))
 
     def plot(self, path=None):
@@ -67,10 +74,34 @@ class OptimizationResult:
         -------
         matplotlib.figure.Figure
         """
-        from ..output import save_figure
-        from .report import pressure_figure
-        fig = pressure_figure(self.scene, self.optimum, self.replay, self.ocp.baseline, self.summary, self.curve,
-                              self.clamp_run)
+        fig = self.figure(self)
         if path is not None:
             save_figure(fig, path)
         return fig
+
+
+def profile_columns(opt, curve, run):
+    """The columns of pressure_profile.csv: {name with unit: array}.
+
+    Rows are the nodes of the piecewise-linear command ``curve`` (the optimum ``opt`` continued by the
+    clamp ramp, :class:`~clutchocp.optimal.clamp.ClampedCommand`): ``to_next`` says how the command goes
+    on to the next row ("linear") or after the last one ("hold": constant). ``phase`` names the segment a
+    row starts: "engagement" before lock-up, "clamp_ramp" from the lock-up row, "clamp_hold" on the last
+    row. ``pressure_Pa`` is the pressure the collocation predicts up to lock-up and the IDAS replay of
+    the whole curve (``run``) after it.
+    """
+    times, command = curve.times, curve.pressures
+    engaged = times <= opt.t_f
+    pressure = np.where(engaged, np.interp(times, opt.t, opt.outputs["pressure_Pa"]),
+                        np.interp(times, run.result.t, run.result["pressure_Pa"]))
+    phase = np.where(times < opt.t_f, "engagement", "clamp_ramp").astype(object)   # the segment a row starts
+    if times[-1] > opt.t_f:
+        phase[-1] = "clamp_hold"
+    to_next = ["linear"] * (times.size - 1) + ["hold"]
+    return {"time_s": times, "pressure_command_Pa": command, "pressure_Pa": pressure,
+            "phase": list(phase), "to_next": to_next}
+
+
+def format_quantity(value, unit, fmt="{:.4g}"):
+    """``value unit`` for a progress line or a title ("none" for None)."""
+    return "none" if value is None else f"{fmt.format(value)} {unit}"

@@ -69,45 +69,22 @@ import casadi as ca
 import numpy as np
 
 from .. import interrupt
-from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
 from .bound import jerk_lower_bound, output_jerk_share
 from .collocation import DirectCollocation, StagedProblem
 from .derivatives import nlp_solver
+from .guess import guess_from_optimum, guess_from_run
 from .heat import heat_limits
+from .mesh import graded_mesh, interval_defects
+from .models import SceneModels
+from .objective import DEFAULT_WEIGHTS, OBJECTIVE_TERMS, SMOOTH_PER_JERK, check_weights  # noqa: F401 (public here)
 from .phases import Phase, PhasedNLP, phased_derivatives
+from .replay import simulate_command
 
-OBJECTIVE_TERMS = ("jerk", "energy", "time", "jump", "smooth", "fill_time", "kiss_speed")
-DEFAULT_WEIGHTS = {"jerk": 1.0, "energy": 0.0, "time": 0.0, "jump": 0.0, "smooth": 0.1, "fill_time": 0.0,
-                   "kiss_speed": 0.0}
-SMOOTH_PER_JERK = 0.1        # default smooth weight per unit jerk weight (see the module notes)
 JUMP_MODES = ("constraint", "penalty")
 SLIP_MODE = "pressing_slip_forward"
 FILL_MODE = "approach_slip_forward"
-
-
-def check_weights(weights):
-    """Full weight dict from a partial one; unknown names or negative weights raise ModelError.
-
-    A missing ``smooth`` weight is ``SMOOTH_PER_JERK`` x the jerk weight (0.1 with the default jerk = 1).
-    """
-    out = dict(DEFAULT_WEIGHTS)
-    for name, value in (weights or {}).items():
-        if name not in DEFAULT_WEIGHTS:
-            raise ModelError(f"weights: unknown term '{name}'; allowed: {', '.join(OBJECTIVE_TERMS)}")
-        try:
-            value = float(value)
-        except (TypeError, ValueError):
-            raise ModelError(f"weights.{name} = {value!r}: must be a number >= 0") from None
-        if not (np.isfinite(value) and value >= 0):
-            raise ModelError(f"weights.{name} = {value!r}: must be a number >= 0")
-        out[name] = value
-    if "smooth" not in (weights or {}):
-        out["smooth"] = SMOOTH_PER_JERK * out["jerk"]
-    if sum(out[k] for k in ("jerk", "energy", "time", "jump", "fill_time", "kiss_speed")) == 0:
-        raise ModelError("weights: at least one of jerk, energy, time, jump, fill_time, kiss_speed must be positive")
-    return out
 
 
 @dataclass
@@ -215,17 +192,21 @@ class EngagementOCP:
         Largest interface temperature [deg C] over the slip phase (needs a [thermal] part).
     max_specific_power_W_mm2 : float, optional
         Largest interface heat power per friction area [W/mm^2] over the slip phase.
+    models : clutchocp.optimal.models.SceneModels, optional
+        The engagement models of ``scene``, shared with other problems and replays of the same scene
+        (its twins, the IDAS checks); default: new ones.
     """
 
     # Scene values that are a parameter vector of the NLP functions (appended to the weights; the
-    # outputs and jump functions take it as a third input); empty here, set by
-    # clutchocp.optimal.robust.ParametricOCP for the scenarios of a robust problem.
+    # outputs and jump functions take it as a third input) and their values; empty here, set by
+    # clutchocp.optimal.parametric.ParametricOCP.
     theta = ca.SX(0, 1)
+    theta_value = np.zeros(0)
 
     def __init__(self, scene, *, intervals=100, degree=3, scheme="radau", control="linear", rate_limit=None,
                  h_min=None, jump="constraint", lock_margin=0.005, smooth=True, polish=True,
                  transcription=None, baseline=None, fill_intervals=30, jerk_max=None, quasi_static_plates=None,
-                 max_temperature_C=None, max_specific_power_W_mm2=None, meshes=None):
+                 max_temperature_C=None, max_specific_power_W_mm2=None, meshes=None, models=None):
         if jump not in JUMP_MODES:
             raise ModelError(f"jump '{jump}': allowed values are {', '.join(JUMP_MODES)}")
         if scene.kind != "engagement":
@@ -248,7 +229,6 @@ class EngagementOCP:
                         "quasi_static_plates": quasi_static_plates, "max_temperature_C": max_temperature_C,
                         "max_specific_power_W_mm2": max_specific_power_W_mm2, "meshes": meshes}
         self.jerk_max = jerk_max
-        self.u = ca.SX.sym("pressure_command")
         self.lock_margin = float(lock_margin)
         self.smooth = bool(smooth)
         self.polish = bool(polish) and self.smooth
@@ -259,9 +239,11 @@ class EngagementOCP:
         # the full model with its masses and the Bao Eq. 22 impact.
         masses = scene.variant("pack") == "masses"
         self.quasi_static_plates = masses if quasi_static_plates is None else bool(quasi_static_plates) and masses
-        ocp_scene = scene.with_overrides({"pack.model": "massless", "pack.plate_masses": None}) \
-            if self.quasi_static_plates else scene
-        self.model = EngagementModel(ocp_scene, smooth=smooth, pressure_command=self.u)
+        self.models = SceneModels(scene) if models is None else models
+        if self.models.scene is not scene:
+            raise ValueError("models: built for another scene")
+        # the model this problem transcribes (and its pressure command symbol)
+        self.model, self.u = self.models.commanded(self.smooth, self.quasi_static_plates)
         self.heat_limits = heat_limits(self.model, max_temperature_C, max_specific_power_W_mm2)
         start_mode = self.model.initial_mode()
         if start_mode not in (SLIP_MODE, FILL_MODE):
@@ -287,17 +269,14 @@ class EngagementOCP:
         self.h_min = h_min
         self.output_jerk_share = 1.0 if self.output_held else output_jerk_share(scene)
         self.has_valve = self.model.actuation.has_state
-        self.state_groups = self._state_groups()
+        self.state_groups = self._state_groups(self.model)
         self.state_names = tuple(self.state_groups)  # the NLP adds the dissipated energy as a last state
         self._names = list(self.state_names)
         self._phys = [self.model.index[n] for n in self._names]
         self.nominal = self.model.nominal[self._phys]
         self.x0 = self.model.initial_state[self._phys]
-        self.scales = self._scales()
-        self.phase_functions = {"slip": self._build_functions(SLIP_MODE, "slip")}
-        if self.phase_modes[0][0] == "fill":
-            self.kiss_jerk_fn = self._kiss_jerk_fn()
-            self.phase_functions["fill"] = self._build_functions(FILL_MODE, "fill")
+        self.scales, self.holds_torque = self._references(self.model)
+        self.phase_functions = self._phase_functions()
         for key, fn in self.phase_functions["slip"].items():     # the slip phase's blocks, as before
             setattr(self, key, fn)
         self.phased = self._phased_nlp()
@@ -306,14 +285,14 @@ class EngagementOCP:
         self._derivatives = None
 
     # -- set-up ---------------------------------------------------------------------------------
-    def _state_groups(self):
-        """Physical states of the NLP: {representative: [model states it stands for]}.
+    def _state_groups(self, model):
+        """Physical states of the NLP for ``model`` (numeric, built with the command ``self.u``):
+        {representative: [model states it stands for]}.
 
         Films that start equal and whose rates are equal whenever their thicknesses are (a massless
         pack without spline friction: the same law and the same load on every film) stay equal, so
         one NLP state carries them all. The check is numerical, at random states on that diagonal.
         """
-        model = self.model
         names = [n for n in model.state_names if not n.startswith("E_")]
         films = [n for n in names if n.startswith("h_")]
         groups = {n: [n] for n in names}
@@ -333,25 +312,29 @@ class EngagementOCP:
         groups[films[0]] = films
         return groups
 
-    def initial_slip(self):
-        """Slip speed and its rate at t = 0: (w_rel [rad/s], dw_rel/dt [rad/s^2])."""
-        w_in, w_out = self.model.speeds()
-        f = ca.Function("slip", [self.model.x], [w_in - w_out, self._slip_rate()])
-        return tuple(float(v) for v in f(self.model.initial_state))
+    def initial_slip(self, model=None):
+        """Slip speed and its rate at t = 0: (w_rel [rad/s], dw_rel/dt [rad/s^2]) (of ``model``, default
+        this problem's)."""
+        model = self.model if model is None else model
+        w_in, w_out = model.speeds()
+        f = ca.Function("slip", [model.x], [w_in - w_out, _slip_rate(model)])
+        return tuple(float(v) for v in f(model.initial_state))
 
-    def _scales(self):
+    def _references(self, model):
+        """The scales of the problem on ``model`` (numeric) with the reference run, and whether its lock
+        carries torque: (Scales, holds_torque)."""
         summary = self.reference_run.summary
         t_ref = summary["engagement_time_s"]
-        w_rel0, rate0 = self.initial_slip()
-        locked0 = float(ca.Function("locked", [self.model.x], [self.model.locked_torque()])(self.model.initial_state))
+        w_rel0, rate0 = self.initial_slip(model)
+        locked0 = float(ca.Function("locked", [model.x], [model.locked_torque()])(model.initial_state))
         jerk_ref = jerk_lower_bound(w_rel0, rate0, t_ref) * max(self.output_jerk_share, 1e-3) ** 2
         peak = summary["peak_torque_Nm"]
         # A lock that carries (almost) no torque: the jump is the slipping torque before it, measured
         # against the peak torque of the reference run.
-        self.holds_torque = abs(locked0) > 0.01 * peak
-        torque = max(abs(locked0), 1.0) if self.holds_torque else peak
+        holds_torque = abs(locked0) > 0.01 * peak
+        torque = max(abs(locked0), 1.0) if holds_torque else peak
         return Scales(time_s=t_ref, energy_J=max(summary["dissipated_energy_J"], 1e-6), jerk_integral=jerk_ref,
-                      torque_Nm=torque, pressure_Pa=self.p_max, speed_m_s=self._reference_kiss_speed())
+                      torque_Nm=torque, pressure_Pa=self.p_max, speed_m_s=self._reference_kiss_speed()), holds_torque
 
     def _reference_kiss_speed(self):
         """Piston speed at the kiss point of the reference run [m/s] (1 without a fill phase)."""
@@ -360,27 +343,45 @@ class EngagementOCP:
             return 1.0
         return max(abs(impact[0].x_before["v0"]), 1e-6)
 
-    def _slip_rate(self):
-        """d w_rel / dt in the slip mode (SX of the full state)."""
-        mode = self.model.modes[SLIP_MODE]
-        w_in, w_out = self.model.speeds()
-        return ca.jtimes(w_in - w_out, self.model.x, ca.vertcat(*mode.ode))
+    def transcribed_model(self):
+        """The model whose equations the NLP functions hold: this problem's (numeric) model."""
+        return self.model
 
-    def _build_functions(self, mode_name=SLIP_MODE, role="slip"):
+    def _phase_functions(self):
+        """The NLP functions of each phase ({phase name: :meth:`_build_functions` dict}) on the
+        :meth:`transcribed_model`."""
+        model = self.transcribed_model()
+        functions = {"slip": self._build_functions(SLIP_MODE, "slip", model)}
+        if self.phase_modes[0][0] == "fill":
+            self.kiss_jerk_fn = self._kiss_jerk_fn(functions["slip"])
+            functions["fill"] = self._build_functions(FILL_MODE, "fill", model)
+        return functions
+
+    def _build_functions(self, mode_name=SLIP_MODE, role="slip", model=None):
         """Scaled dynamics, objective and end conditions, and the physical outputs of one phase.
+
+        Parameters
+        ----------
+        mode_name, role : str
+            The model mode of the phase and its name (``"slip"`` or ``"fill"``).
+        model : clutchocp.engagement.model.EngagementModel, optional
+            The model whose equations are transcribed (default: this problem's): built with the command
+            ``self.u`` and the states of this problem's model, its values numbers or the symbols theta.
 
         Returns
         -------
         dict
-            ``dynamics_fn (xs, us, weights) -> (xdot, q, c)``, ``objective_fn (xs, us, Q, T, weights)``,
-            ``end_fn (xs, us, T, weights)``, ``outputs_fn (xs, us)``, ``jump_fn (xs, us)``, ``subs``
-            (physical SX of the model state -> SX of the scaled NLP state) and ``output_names``.
+            ``dynamics_fn (xs, us, params) -> (xdot, q, c)``, ``objective_fn (xs, us, Q, T, params)``,
+            ``end_fn (xs, us, T, params)``, ``outputs_fn (xs, us[, theta])``, ``jump_fn (xs, us[, theta])``,
+            ``subs`` (physical SX of the model state -> SX of the scaled NLP state) and ``output_names``;
+            ``params`` is ``[weights; theta]``.
         """
-        model, mode, sc = self.model, self.model.modes[mode_name], self.scales
+        model = self.model if model is None else model
+        mode, sc = model.modes[mode_name], self.scales
         n = len(self._phys)
         xs = ca.SX.sym("xs", n + 1)                 # physical states, then the dissipated energy
         us = ca.SX.sym("us")
-        x_full = self._full_state(xs)
+        x_full = self._full_state(xs, model)
         u = us * sc.pressure_Pa
         ode = ca.vertcat(*mode.ode)
         w_in, w_out = model.speeds()
@@ -401,13 +402,7 @@ class EngagementOCP:
         }
         for i in range(model.n):
             physical[f"h_{i + 1}_m"] = mode.outputs[f"h_{i + 1}_m"]
-        if model.has_piston:
-            axial = mode_name.split("_")[0]
-            x0 = model.piston_position(axial)
-            physical["piston_position_m"] = x0
-            physical["piston_speed_m_s"] = model.state("v0")
-            physical["spring_force_N"] = model.drive_force(0.0, x0)       # Bao Eq. 21 at p = 0 (signed)
-            physical["pack_force_N"] = mode.outputs["pack_force_N"]
+        physical.update(piston_outputs(model, mode_name))
         physical.update({k: mode.outputs[k] for k in ("interface_heat_power_W", "interface_temperature_C")
                          if k in mode.outputs})
         physical = {k: ca.SX(v) for k, v in physical.items()}
@@ -449,7 +444,7 @@ class EngagementOCP:
                  + w["kiss_speed"] * kiss**2)
             out["objective_fn"] = ca.Function("objective", [xs, us, Q, T, params], [J])
             i_x0 = self._names.index("x0")
-            g_end = [xs[i_x0] - self.model.travel / self.nominal[i_x0]]
+            g_end = [xs[i_x0] - model.travel / self.nominal[i_x0]]
             if self.jerk_max is not None:     # the jerk just after the kiss (slip mode, after the reset)
                 g_end.append(self.kiss_jerk_fn(xs, us) / self.jerk_max)
             out["end_fn"] = ca.Function("end", [xs, us, T, params], [ca.vertcat(*g_end)])
@@ -470,15 +465,17 @@ class EngagementOCP:
         out["jump_fn"] = ca.Function("jump", [xs, us, *theta], [jump * sc.torque_Nm])
         return out
 
-    def _full_state(self, xs):
-        """The model state (SX, SI) from the scaled NLP state ``xs`` (equal films copied)."""
-        x_full = ca.SX.zeros(len(self.model.state_names))
+    def _full_state(self, xs, model=None):
+        """The state (SX, SI) of ``model`` (default: this problem's) from the scaled NLP state ``xs``
+        (equal films copied)."""
+        model = self.model if model is None else model
+        x_full = ca.SX.zeros(len(model.state_names))
         for k, name in enumerate(self._names):
             for member in self.state_groups[name]:
-                x_full[self.model.index[member]] = xs[k] * self.nominal[k]
+                x_full[model.index[member]] = xs[k] * self.nominal[k]
         return x_full
 
-    def _staged_problem(self, role="slip"):
+    def staged_problem(self, role="slip"):
         """The scaled problem of one phase (``x0`` given for the first phase only)."""
         n = len(self._phys)
         fns = self.phase_functions[role]
@@ -523,7 +520,7 @@ class EngagementOCP:
         phases = []
         for name, mode in self.phase_modes:
             tr = self.fill_transcription if name == "fill" else self.transcription
-            phases.append(Phase(name, mode, self._staged_problem(name), tr))
+            phases.append(Phase(name, mode, self.staged_problem(name), tr))
         links = [self.impact_link()] if len(phases) > 1 else []
         nlp = PhasedNLP(phases, links)
         if len(phases) > 1 and self.apply_pressure == 0.0:
@@ -575,11 +572,11 @@ class EngagementOCP:
         after.append(xs[n] + loss / self.scales.energy_J)
         return ca.Function("impact_reset", [xs], [ca.vertcat(*after)])
 
-    def _kiss_jerk_fn(self):
-        """The felt jerk just after the kiss [rad/s^3]: the slip mode's, at the impact-reset state."""
+    def _kiss_jerk_fn(self, slip):
+        """The felt jerk just after the kiss [rad/s^3]: the slip mode's (``slip``: its functions), at the
+        impact-reset state."""
         n = len(self._phys)
         xs, us = ca.SX.sym("xs", n + 1), ca.SX.sym("us")
-        slip = self.phase_functions["slip"]
         index = slip["output_names"].index("slip_jerk_rad_s3" if self.output_held else "output_jerk_rad_s3")
         return ca.Function("kiss_jerk", [xs, us], [slip["outputs_fn"](self.impact_reset()(xs), us)[index]])
 
@@ -605,7 +602,7 @@ class EngagementOCP:
         """The twin problem on the exact forms (the polish stage), built on first use."""
         if self._exact is None:
             self._exact = EngagementOCP(self.scene, smooth=False, polish=False, baseline=self.baseline,
-                                        transcription=self.transcription, **self.options)
+                                        transcription=self.transcription, models=self.models, **self.options)
         return self._exact
 
     def refined(self, opt):
@@ -614,7 +611,6 @@ class EngagementOCP:
         Each phase keeps its number of intervals; its new interval shares equidistribute the defects
         (:func:`clutchocp.optimal.mesh.graded_mesh`). The baseline run is shared.
         """
-        from .mesh import graded_mesh, interval_defects
         solved_on = self.exact if self.polish and opt.stats.get("model") == "exact" else self
         defects = interval_defects(solved_on, opt)
         return self.with_meshes({name: graded_mesh(part.transcription.mesh, e, part.transcription.degree)
@@ -626,7 +622,8 @@ class EngagementOCP:
         tr = self.transcription
         options = dict(self.options, meshes=None, intervals=max(2, int(round(fraction * tr.intervals))),
                        degree=tr.degree, scheme=tr.scheme, control=tr.control)
-        twin = EngagementOCP(self.scene, smooth=self.smooth, polish=self.polish, baseline=self.baseline, **options)
+        twin = EngagementOCP(self.scene, smooth=self.smooth, polish=self.polish, baseline=self.baseline,
+                             models=self.models, **options)
         twin._fastest = self._fastest
         return twin
 
@@ -635,7 +632,8 @@ class EngagementOCP:
         tr = self.transcription
         options = dict(self.options, meshes=meshes, intervals=tr.intervals, degree=tr.degree, scheme=tr.scheme,
                        control=tr.control)
-        twin = EngagementOCP(self.scene, smooth=self.smooth, polish=self.polish, baseline=self.baseline, **options)
+        twin = EngagementOCP(self.scene, smooth=self.smooth, polish=self.polish, baseline=self.baseline,
+                             models=self.models, **options)
         twin._fastest = self._fastest
         return twin
 
@@ -694,7 +692,6 @@ class EngagementOCP:
 
     def _solve_stage(self, t_max, e_max, weights, guess):
         """One IPOPT solve of this problem (no polish)."""
-        from .guess import guess_from_optimum, guess_from_run
         nlp, sc = self.phased, self.scales
         warm = isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size \
             and guess.lam_g.size == nlp.lbg.size and self._same_meshes(guess)
@@ -797,7 +794,7 @@ class EngagementOCP:
             "slip_jerk_integral": sum(p["integrals"]["slip_jerk_rad_s3"] for p in pieces),
             "dissipated_energy_J": float(xf[-1] * sc.energy_J),
             "engagement_time_s": T,
-            "lockup_torque_jump_Nm": float(self.jump_fn(xf, uf)),
+            "lockup_torque_jump_Nm": self.lockup_jump(xf, uf),
             "final_slip_rad_s": float(outputs["w_rel_rad_s"][-1]),
             "locked_torque_Nm": float(outputs["locked_torque_Nm"][-1]) if self.holds_torque else 0.0,
             "peak_jerk_rad_s3": float(np.max(np.abs(outputs_points[felt]))),
@@ -830,11 +827,11 @@ class EngagementOCP:
         command_times = starts[:n_u] if tr.control == "constant" else starts
         # Outputs at the nodes use the command of the interval they start (the last node: the last value).
         u_nodes = np.concatenate([u_values, u_values[-1:]]) if tr.control == "constant" else u_values
-        outputs = self._evaluate(parts["x"], u_nodes / sc.pressure_Pa, fns)
+        outputs = self.outputs_at(parts["x"], u_nodes / sc.pressure_Pa, fns)
         outputs["dissipated_energy_J"] = parts["x"][:, -1] * sc.energy_J
         xc = parts["xc"].reshape(-1, parts["xc"].shape[-1])
         uc = np.array(tr.control_at_points(ca.DM(parts["u"].T))).ravel()
-        outputs_points = {k: v.reshape(points.shape) for k, v in self._evaluate(xc, uc, fns).items()}
+        outputs_points = {k: v.reshape(points.shape) for k, v in self.outputs_at(xc, uc, fns).items()}
         quad = tr.B[None, :] * tr.steps(T)[:, None]
         integrals = {key: float(np.sum(quad * outputs_points[key] ** 2))
                      for key in ("output_jerk_rad_s3", "slip_jerk_rad_s3")}
@@ -844,10 +841,28 @@ class EngagementOCP:
                 "outputs_points": outputs_points, "states": states, "integrals": integrals,
                 "x": parts["x"], "u": parts["u"]}
 
-    def _evaluate(self, xs, us, fns=None):
+    def outputs_at(self, xs, us, fns=None, theta=None):
+        """Physical outputs at scaled states ``xs`` (rows) and commands ``us`` of a phase (``fns``: its
+        functions, default the slip phase's), at the parameter values ``theta`` (default
+        :attr:`theta_value`): {output name: array}."""
         fns = fns or self.phase_functions["slip"]
-        values = np.array(fns["outputs_fn"].map(len(us))(np.asarray(xs).T, np.asarray(us)[None, :]))
+        n = len(us)
+        values = np.array(fns["outputs_fn"].map(n)(np.asarray(xs).T, np.asarray(us)[None, :],
+                                                   *self._theta_columns(n, theta)))
         return {name: values[i] for i, name in enumerate(fns["output_names"])}
+
+    def lockup_jump(self, xs, us, theta=None):
+        """Locked minus slipping torque [N m] at the scaled end state ``xs`` and command ``us`` (slip phase),
+        at the parameter values ``theta`` (default :attr:`theta_value`)."""
+        return float(self.jump_fn(xs, us, *self._theta_columns(1, theta)))
+
+    def _theta_columns(self, n, theta=None):
+        """The parameter values as the extra input of the outputs and jump functions for ``n`` points
+        (none without parameters)."""
+        if not self.theta.numel():
+            return []
+        value = np.asarray(self.theta_value if theta is None else theta, float)
+        return [np.repeat(value[:, None], n, axis=1)]
 
     # -- feasibility ----------------------------------------------------------------------------
     def default_t_max(self):
@@ -863,9 +878,8 @@ class EngagementOCP:
         """IDAS run of a step of the command to the pressure that applies the clutch hardest (cached):
         the pressure limit, or zero for a spring-applied piston (the pressure releases it)."""
         if self._fastest is None:
-            from .replay import simulate_command
             t_end = self.scene.value("simulation.t_end")
-            run = simulate_command(self.scene, [0.0], [self.apply_pressure], t_end)
+            run = simulate_command(self.scene, [0.0], [self.apply_pressure], t_end, model=self.models.replay())
             if run.summary["engagement_time_s"] is None:
                 raise ModelError(f"scene '{self.scene.name}': even a step to {self._apply_label()} does not lock "
                                  f"up within simulation.t_end = {t_end:g} s; raise the pressure limit or t_end")
@@ -886,12 +900,33 @@ class EngagementOCP:
         """Lock-up time [s] of a step to :attr:`apply_pressure` (no command within the limits locks sooner)."""
         return self.fastest_run().summary["engagement_time_s"]
 
-    def check_feasible_time(self, t_max):
-        """Raise ModelError if no command under the pressure limit locks up by ``t_max``."""
-        if t_max >= self.scales.time_s and self.baseline.summary["engagement_time_s"] is not None:
+    def check_feasible_time(self, t_max, t_ref=None):
+        """Raise ModelError if no command under the pressure limit locks up by ``t_max``.
+
+        ``t_ref``: the lock-up time of the baseline [s] (default: the time scale, its lock-up time)."""
+        t_ref = self.scales.time_s if t_ref is None else t_ref
+        if t_max >= t_ref and self.baseline.summary["engagement_time_s"] is not None:
             return
         fastest = self.fastest_lockup()
         if t_max < fastest:
             raise ModelError(f"t_max = {t_max:.4g} s is below the fastest lock-up the pressure limit allows "
                              f"({fastest:.4g} s with a step to {self._apply_label()}); "
                              f"raise t_max or the pressure limit")
+
+
+def _slip_rate(model):
+    """d w_rel / dt in the slip mode of ``model`` (SX of the full state)."""
+    mode = model.modes[SLIP_MODE]
+    w_in, w_out = model.speeds()
+    return ca.jtimes(w_in - w_out, model.x, ca.vertcat(*mode.ode))
+
+
+def piston_outputs(model, mode_name):
+    """The piston's outputs in a mode (SX): position, speed, spring force at p = 0 (Bao Eq. 21, signed)
+    and pack force; none for a model without a piston."""
+    if not model.has_piston:
+        return {}
+    mode = model.modes[mode_name]
+    x0 = model.piston_position(mode_name.split("_")[0])
+    return {"piston_position_m": x0, "piston_speed_m_s": model.state("v0"),
+            "spring_force_N": model.drive_force(0.0, x0), "pack_force_N": mode.outputs["pack_force_N"]}

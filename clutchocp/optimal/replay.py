@@ -33,13 +33,18 @@ class CommandModel:
     control : {"constant", "linear"}
         Piecewise-constant command (the input itself) or piecewise-linear (the command is
         ``offset + slope * t`` with both piecewise constant, so the run restarts at every node).
+    engagement, command : EngagementModel, casadi.SX, optional
+        The exact model of ``scene`` already built with ``pressure_command=command`` (default: built here).
     """
 
-    def __init__(self, scene, control="constant"):
+    def __init__(self, scene, control="constant", engagement=None, command=None):
         self.scene = scene
         self.control = control
-        u = ca.SX.sym(COMMAND)
-        self.engagement = EngagementModel(scene, smooth=False, pressure_command=u)
+        if engagement is None:
+            command = ca.SX.sym(COMMAND)
+            engagement = EngagementModel(scene, smooth=False, pressure_command=command)
+        u = command
+        self.engagement = engagement
         if control == "constant":
             self.hybrid = self.engagement.hybrid
         elif control == "linear":

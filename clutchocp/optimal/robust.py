@@ -27,7 +27,7 @@ again from the last solution (a coarse presolve on 10 command steps finds the in
 the fine grid needs few such re-solves). The first lock-up intervals are those of each scenario's
 IDAS replay of the nominal optimum (:meth:`RobustOCP.start_runs`). With one scenario that locks at t_max (the jerk optimum
 uses all the time it may) the mesh is the nominal problem's and so is the optimum (checked in
-tests/test_optimal_robust.py).
+tests/optimal/test_optimal_robust.py).
 
 Lock-up torque jump: each scenario may meet the nominal jump condition (``jump="constraint"``, the
 default of :class:`~clutchocp.optimal.problem.EngagementOCP`), but one command can rarely make
@@ -51,11 +51,13 @@ has to land the fastest clutch early and sweep slowly through the others. The "s
 the first and the last corner to lock, so that the worst jump between the box points is held too.
 
 One dynamics function for all scenarios. The uncertain scene values are symbols of the model
-(:class:`clutchocp.scene.symbolic.SymbolicScene`): :class:`ParametricOCP` builds the scaled dynamics, objective and end
-functions of the nominal problem with a parameter vector theta of those values, and the robust
-NLP evaluates the dynamics at every collocation point of every scenario by one CasADi ``map``
-(theta of the point's scenario as an input), so the cost of the NLP functions grows linearly with
-the number of scenarios. Scales, state groups and the initial state are those of the nominal scene.
+(:class:`clutchocp.scene.symbolic.SymbolicScene`): :class:`~clutchocp.optimal.parametric.ParametricOCP`
+builds the scaled dynamics, objective and end functions of the nominal problem with a parameter
+vector theta of those values, and the robust NLP (the scenarios transcribed under the shared command
+by :class:`~clutchocp.optimal.scenarios.SharedCommandCollocation`) evaluates the dynamics at every
+collocation point of every scenario by one CasADi ``map`` (theta of the point's scenario as an
+input), so the cost of the NLP functions grows linearly with the number of scenarios. Scales, state
+groups and the initial state are those of the nominal scene.
 
 Stages: as for the nominal problem, first the smooth forms of the switching laws, then a warm-started
 polish on the exact forms. Derivatives: CasADi's automatic differentiation of the NLP graph (the
@@ -69,16 +71,16 @@ import casadi as ca
 import numpy as np
 
 from .. import interrupt
-from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
-from ..scene.symbolic import SymbolicScene
 from .clamp import ClampModel
-from .collocation import _repeat_columns, _sparse
 from .derivatives import IPOPT_OPTIONS, WARM_OPTIONS
 from .guess import guess_from_run
-from .problem import OBJECTIVE_TERMS, SLIP_MODE, EngagementOCP, OptimalEngagement, check_weights
+from .objective import OBJECTIVE_TERMS, check_weights
+from .parametric import ParametricOCP
+from .problem import EngagementOCP, OptimalEngagement
 from .replay import simulate_command
+from .scenarios import ScenarioNLP, SharedCommandCollocation
 
 AGGREGATES = ("mean", "worst", "worst_jump")
 PRESOLVE_INTERVALS = 10
@@ -91,81 +93,6 @@ STARTS = ("nominal", "ramp", "baseline", "sweep")      # start points tried in t
 SWEEP_CAPACITY = 1.5
 # Positions on the box diagonal from the first to the last corner to lock of the points lock_diagonal adds
 DIAGONAL_FRACTIONS = (0.25, 0.75)
-
-
-class ParametricOCP(EngagementOCP):
-    """The nominal engagement problem of a scene with some scene values as a parameter vector theta.
-
-    ``dynamics_fn``, ``objective_fn`` and ``end_fn`` take ``[weights; theta]`` as their parameter,
-    ``outputs_fn`` and ``jump_fn`` take theta as a third input. Scales, state groups, initial state
-    and the baseline are the nominal scene's.
-
-    Parameters
-    ----------
-    scene : clutchocp.scene.Scene
-    names : sequence of str
-        Scene fields (numeric, ``"part.key"``) that become theta.
-    **options
-        As for :class:`~clutchocp.optimal.problem.EngagementOCP`.
-    """
-
-    def __init__(self, scene, names, **options):
-        self.parameter_names = tuple(names)
-        self.theta = ca.SX.sym("theta", len(self.parameter_names))
-        self.theta_value = self.nominal_theta(scene)
-        super().__init__(scene, **options)
-
-    def nominal_theta(self, scene):
-        """theta of a scene (its SI values of the parameter names)."""
-        values = []
-        for name in self.parameter_names:
-            value = scene.value(name)
-            if not isinstance(value, (int, float, np.floating, np.integer)) or isinstance(value, bool):
-                raise ModelError(f"{name}: a robust scenario may vary numeric scene values only (got {value!r})")
-            values.append(float(value))
-        return np.array(values)
-
-    def _build_functions(self, mode_name=SLIP_MODE, role="slip"):
-        numeric = self.model
-        symbols = dict(zip(self.parameter_names, ca.vertsplit(self.theta)))
-        try:
-            self.model = EngagementModel(SymbolicScene(self.scene, symbols), smooth=self.smooth,
-                                         pressure_command=self.u)
-            out = super()._build_functions(mode_name, role)
-        except (TypeError, RuntimeError, NotImplementedError) as exc:
-            raise ModelError(f"{', '.join(self.parameter_names)}: the engagement model cannot take these values as "
-                             f"symbols of one collocation problem ({type(exc).__name__}: {str(exc).splitlines()[0]})"
-                             ) from None
-        finally:
-            self.model = numeric
-        # The jump as a share of the scenario's own locked torque, (locked - slipping) / locked at the
-        # end state (the measure of the Monte Carlo): the rows of the worst-jump epigraph.
-        xs, us = ca.SX.sym("xs", self.x0.size + 1), ca.SX.sym("us")
-        theta = [self.theta] if self.theta.numel() else []
-        values = out["outputs_fn"](xs, us, *theta)
-        locked = values[out["output_names"].index("locked_torque_Nm")]
-        slipping = values[out["output_names"].index("total_torque_Nm")]
-        out["relative_jump_fn"] = ca.Function("relative_jump", [xs, us, self.theta],
-                                              [(locked - slipping) / locked])
-        if self.theta.numel():
-            jump_theta = out["jump_fn"]
-            out["jump_fn"] = lambda x, u: jump_theta(x, u, self.theta_value)
-        return out
-
-    def _evaluate(self, xs, us):
-        if not self.theta.numel():
-            return super()._evaluate(xs, us)
-        n = len(us)
-        values = np.array(self.outputs_fn.map(n)(np.asarray(xs).T, np.asarray(us)[None, :],
-                                                 np.repeat(self.theta_value[:, None], n, axis=1)))
-        return {name: values[i] for i, name in enumerate(self.output_names)}
-
-    @property
-    def exact(self):
-        if self._exact is None:
-            self._exact = ParametricOCP(self.scene, self.parameter_names, smooth=False, polish=False,
-                                        baseline=self.baseline, transcription=self.transcription, **self.options)
-        return self._exact
 
 
 @dataclass
@@ -289,7 +216,7 @@ class RobustOCP:
         command interval each scenario locks in."""
         key = (id(ocp), aggregate, float(t_max), tuple(lock_intervals))
         if key not in self._nlps:
-            self._nlps[key] = _transcribe(ocp, aggregate, t_max / ocp.scales.time_s, self.intervals,
+            self._nlps[key] = _robust_nlp(ocp, aggregate, t_max / ocp.scales.time_s, self.intervals,
                                           tuple(int(k) for k in lock_intervals))
         return self._nlps[key]
 
@@ -373,7 +300,7 @@ class RobustOCP:
         starts = (("sweep",) + tuple(k for k in STARTS if k != "sweep")) if aggregate == "worst_jump" else STARTS
         if presolve_intervals is not None and presolve_intervals < self.intervals:
             coarse = RobustOCP(self.scene, self.overrides, intervals=presolve_intervals,
-                               **dict(self._ocp_options, polish=False, baseline=ocp.baseline))
+                               **dict(self._ocp_options, polish=False, baseline=ocp.baseline, models=ocp.models))
             coarse._fastest, coarse._weights = fastest, weights
             # The problem is not convex: the presolve runs from every start and keeps the lowest objective
             # (two scenarios mu +-5 %, 12 steps, mean: 4.07 from the ramp start, 4.66 from the nominal one).
@@ -436,7 +363,7 @@ class RobustOCP:
             # A lock-up interval no command meets shows as a local infeasibility, with the lock-up
             # of the scenario at fault on a bound of its interval: move it there and solve again.
             last = result
-            moves = nlp.interval_moves(result.w, result.lam_x, stuck=not result.success)
+            moves = nlp.grid.interval_moves(result.w, result.lam_x, stuck=not result.success)
             moves[moves == -previous_moves] = 0           # no move back: that oscillates between two intervals
             if not np.any(moves):
                 break
@@ -525,7 +452,7 @@ class RobustOCP:
         cached per t_max), or None if IPOPT fails on it."""
         key = (float(t_max), tuple(sorted(self._weights.items())))
         if getattr(self, "_nominal_key", None) != key:
-            options = dict(self._ocp_options, polish=False, baseline=self.ocp.baseline)
+            options = dict(self._ocp_options, polish=False, baseline=self.ocp.baseline, models=self.ocp.models)
             try:
                 self._nominal = EngagementOCP(self.scene, intervals=self.intervals, **options).solve(
                     t_max=t_max, weights=self._weights)
@@ -548,9 +475,9 @@ class RobustOCP:
         w0 = np.clip(w0, nlp.lbx, nlp.ubx)
         p = np.concatenate([[weights[k] for k in OBJECTIVE_TERMS], self.thetas.ravel(), omega])
         if aggregate == "worst" and not warm:                 # the epigraph variable starts on its bound
-            w0[nlp.tau_slice.stop:] = np.max(np.array(nlp.objectives_fn(w0, p)))
+            w0[nlp.grid.tau_slice.stop:] = np.max(np.array(nlp.objectives_fn(w0, p)))
         elif aggregate == "worst_jump" and not warm:
-            w0[nlp.tau_slice.stop:] = np.max(np.abs(np.array(nlp.jumps_fn(w0, p))))
+            w0[nlp.grid.tau_slice.stop:] = np.max(np.abs(np.array(nlp.jumps_fn(w0, p))))
         solver = self.solver(nlp, warm)
         start = time.perf_counter()
         with interrupt.in_solver():
@@ -562,7 +489,7 @@ class RobustOCP:
         stats = {"status": st["return_status"], "success": bool(st["success"]), "iterations": int(st["iter_count"]),
                  "wall_time_s": wall, "warm_start": bool(warm), "n_variables": int(w0.size),
                  "n_constraints": int(nlp.lbg.size), "n_scenarios": self.n_scenarios,
-                 "lock_intervals": [int(k) for k in nlp.lock_intervals]}
+                 "lock_intervals": [int(k) for k in nlp.grid.lock_intervals]}
         return self._result(ocp, nlp, np.array(sol["x"]).ravel(), np.array(sol["lam_x"]).ravel(),
                             np.array(sol["lam_g"]).ravel(), float(sol["f"]), p, weights, aggregate, omega, t_max,
                             stats, sc)
@@ -572,8 +499,8 @@ class RobustOCP:
         run under a step of the command to the pressure limit (see :meth:`_lock_guess`)."""
         sc = ocp.scales
         t_lock = previous.lock_times if previous is not None else self._lock_guess(t_max)
-        T = nlp.clip_lock_times(t_lock / sc.time_s)
-        times = nlp.scenario_times(T)                           # scaled node / point times per scenario
+        T = nlp.grid.clip_lock_times(t_lock / sc.time_s)
+        times = nlp.grid.scenario_times(T)                      # scaled node / point times per scenario
         xs, xcs = [], []
         if previous is not None:
             for k, opt in enumerate(previous.scenarios):
@@ -586,8 +513,9 @@ class RobustOCP:
                     return np.stack(cols, axis=-1)
                 xs.append(at(times[k][0]))
                 xcs.append(at(times[k][1]))
-            v = np.interp(nlp.command_grid, previous.command_times / sc.time_s, previous.command / sc.pressure_Pa)
-            return nlp.pack(xs, xcs, v, T)
+            v = np.interp(nlp.grid.command_grid, previous.command_times / sc.time_s,
+                          previous.command / sc.pressure_Pa)
+            return nlp.grid.pack(xs, xcs, v, T)
         tr = ocp.transcription
         for k, run in enumerate(self.start_runs(t_max)):
             parts = ocp.nlp.unpack(guess_from_run(ocp, run, t_max=t_max))
@@ -597,35 +525,35 @@ class RobustOCP:
             xs.append(xcol[0])
             xcs.append(xcol[1])
         times_c, values_c = self._start_command
-        v = np.interp(nlp.command_grid * sc.time_s, times_c, values_c) / sc.pressure_Pa
-        return nlp.pack(xs, xcs, v, T)
+        v = np.interp(nlp.grid.command_grid * sc.time_s, times_c, values_c) / sc.pressure_Pa
+        return nlp.grid.pack(xs, xcs, v, T)
 
     def _result(self, ocp, nlp, w, lam_x, lam_g, objective, p, weights, aggregate, omega, t_max, stats, sc):
-        parts = nlp.unpack(w)
+        parts = nlp.grid.unpack(w)
         command = np.clip(parts["v"], 0.0, 1.0) * sc.pressure_Pa
         J = np.array(nlp.objectives_fn(w, p)).ravel()
-        times = nlp.scenario_times(parts["T"])
+        times = nlp.grid.scenario_times(parts["T"])
         scenarios = []
         for k in range(self.n_scenarios):
-            ocp.theta_value = self.thetas[k]
-            scenarios.append(_scenario_result(ocp, nlp, parts, k, times[k], float(J[k]), weights, stats, t_max))
-        ocp.theta_value = ocp.nominal_theta(self.scene)
-        return RobustEngagement(nlp.command_grid * sc.time_s, command, scenarios, self.overrides, J, objective,
+            scenarios.append(_scenario_result(ocp, nlp, parts, k, times[k], float(J[k]), weights, stats, t_max,
+                                              self.thetas[k]))
+        return RobustEngagement(nlp.grid.command_grid * sc.time_s, command, scenarios, self.overrides, J, objective,
                                 aggregate, weights, omega, t_max, stats, w, lam_x, lam_g)
 
 
-def _scenario_result(ocp, nlp, parts, k, times, objective, weights, stats, t_max):
-    """One scenario of a robust solution as an OptimalEngagement (its own mesh, the shared command)."""
+def _scenario_result(ocp, nlp, parts, k, times, objective, weights, stats, t_max, theta):
+    """One scenario (parameter values ``theta``) of a robust solution as an OptimalEngagement (its own
+    mesh, the shared command)."""
     sc, d = ocp.scales, ocp.transcription.degree
     starts, points = times
     T = parts["T"][k]
     x, xc = parts["x"][k], parts["xc"][k]
     v = np.clip(parts["v"], 0.0, 1.0)
-    u_nodes = np.interp(starts, nlp.command_grid, v)
-    u_points = np.interp(points, nlp.command_grid, v)
-    outputs = ocp._evaluate(x, u_nodes)
+    u_nodes = np.interp(starts, nlp.grid.command_grid, v)
+    u_points = np.interp(points, nlp.grid.command_grid, v)
+    outputs = ocp.outputs_at(x, u_nodes, theta=theta)
     outputs["dissipated_energy_J"] = x[:, -1] * sc.energy_J
-    flat = ocp._evaluate(xc.reshape(-1, xc.shape[-1]), u_points.ravel())
+    flat = ocp.outputs_at(xc.reshape(-1, xc.shape[-1]), u_points.ravel(), theta=theta)
     outputs_points = {name: value.reshape(points.shape) for name, value in flat.items()}
     steps = np.diff(starts)[:, None]                             # scaled interval lengths
     quad = ocp.transcription.B[None, :] * steps * sc.time_s
@@ -634,7 +562,7 @@ def _scenario_result(ocp, nlp, parts, k, times, objective, weights, stats, t_max
         "slip_jerk_integral": float(np.sum(quad * outputs_points["slip_jerk_rad_s3"] ** 2)),
         "dissipated_energy_J": float(x[-1, -1] * sc.energy_J),
         "engagement_time_s": T * sc.time_s,
-        "lockup_torque_jump_Nm": float(ocp.jump_fn(x[-1], u_nodes[-1])),
+        "lockup_torque_jump_Nm": ocp.lockup_jump(x[-1], u_nodes[-1], theta),
         "final_slip_rad_s": float(outputs["w_rel_rad_s"][-1]),
         "locked_torque_Nm": float(outputs["locked_torque_Nm"][-1]),
         "peak_jerk_rad_s3": float(np.max(np.abs(outputs_points["output_jerk_rad_s3"]))),
@@ -653,221 +581,82 @@ def _scenario_result(ocp, nlp, parts, k, times, objective, weights, stats, t_max
 
 
 @dataclass
-class _RobustNLP:
-    """The robust NLP and how to read its variables (scaled units).
+class RobustNLP:
+    """The robust NLP: the scenarios' transcription (``grid``: layout, unpack, lock intervals) with the
+    aggregate objective and its rows.
 
-    Scenario s has ``lock_intervals[s]`` = K_s full command intervals, then a last interval of free
-    length tau_s in (0, h_c] (its lock-up at T_s = K_s h_c + tau_s).
+    ``objectives_fn (w, p)`` gives each scenario's J_s, ``jumps_fn (w, p)`` each scenario's
+    (locked - slipping) / locked torque at its lock-up; the NLP parameter p is ``[weights; theta of
+    each scenario; scenario weights]``.
     """
 
+    grid: ScenarioNLP
     nlp: dict
-    lbx: np.ndarray
-    ubx: np.ndarray
     lbg: np.ndarray
     ubg: np.ndarray
-    x_offsets: list                    # (start, n_nodes) of each scenario's node states in w
-    xc_offsets: list                   # (start, n_points) of each scenario's point states in w
-    v_slice: slice
-    tau_slice: slice
-    n_x: int
-    degree: int
-    tau: np.ndarray                    # collocation points in (0, 1]
-    h_c: float
-    lock_intervals: tuple
-    command_grid: np.ndarray           # scaled times of the command nodes
-    objectives_fn: ca.Function         # (w, p) -> J_s of each scenario
-    tau_min: float
-    jumps_fn: ca.Function              # (w, p) -> (locked - slipping) / locked torque at each lock-up
+    objectives_fn: ca.Function
+    jumps_fn: ca.Function
 
     @property
-    def t_upper(self):
-        return self.command_grid[-1]
+    def lbx(self):
+        return self.grid.lbx
 
-    def unpack(self, w):
-        w = np.asarray(w, float).ravel()
-        d, n_x = self.degree, self.n_x
-        x = [w[a:a + n * n_x].reshape(n, n_x) for a, n in self.x_offsets]
-        xc = [w[a:a + n * n_x].reshape(n // d, d, n_x) for a, n in self.xc_offsets]
-        tau = w[self.tau_slice]
-        T = np.array(self.lock_intervals) * self.h_c + tau
-        return {"x": x, "xc": xc, "v": w[self.v_slice], "tau": tau, "T": T}
-
-    def pack(self, x, xc, v, T):
-        w = np.zeros(self.lbx.size)
-        for (a, n), xs in zip(self.x_offsets, x):
-            w[a:a + n * self.n_x] = np.asarray(xs, float).ravel()
-        for (a, n), xcs in zip(self.xc_offsets, xc):
-            w[a:a + n * self.n_x] = np.asarray(xcs, float).ravel()
-        w[self.v_slice] = v
-        w[self.tau_slice] = np.asarray(T, float) - np.array(self.lock_intervals) * self.h_c
-        return w
-
-    def clip_lock_times(self, T):
-        """Scaled lock times moved into each scenario's lock interval."""
-        K = np.array(self.lock_intervals)
-        return np.clip(T, K * self.h_c + self.tau_min, (K + 1) * self.h_c)
-
-    def scenario_times(self, T=None):
-        """Scaled (node times, point times (K+1, d)) of each scenario (at lock times T, default the
-        end of each lock interval)."""
-        K = np.array(self.lock_intervals)
-        T = (K + 1) * self.h_c if T is None else np.asarray(T, float)
-        out = []
-        for Ks, Ts in zip(K, T):
-            starts = np.append(np.arange(Ks + 1) * self.h_c, Ts)
-            steps = np.diff(starts)
-            out.append((starts, starts[:-1, None] + steps[:, None] * self.tau[None, :]))
-        return out
-
-    def interval_moves(self, w, lam_x, tol=1e-6, stuck=False):
-        """+1 / -1 for a scenario whose lock-up sits on the end / start of its command interval with a
-        multiplier pushing it beyond (and a next / previous interval exists), else 0.
-
-        ``stuck``: the solve failed; move every lock-up that sits on a bound (multipliers ignored).
-        """
-        tau, lam = w[self.tau_slice], lam_x[self.tau_slice]
-        K = np.array(self.lock_intervals)
-        n_int = self.command_grid.size - 1
-        at_end = tau >= self.h_c * (1 - (1e-3 if stuck else 1e-6))
-        at_start = tau <= self.tau_min + (1e-3 * self.h_c if stuck else 1e-3 * self.tau_min)
-        up = at_end & ((lam > tol) | stuck) & (K < n_int - 1)
-        down = at_start & ((lam < -tol) | stuck) & (K > 0)
-        return up.astype(int) - down.astype(int)
+    @property
+    def ubx(self):
+        return self.grid.ubx
 
 
-def _transcribe(ocp, aggregate, t_grid_end, n_int, lock_intervals):
-    """Transcribe the robust problem on the functions of ``ocp`` (see :class:`_RobustNLP`).
-
-    The NLP parameter is ``[weights (5); theta of each scenario; scenario weights]``.
-    """
-    tr, prob = ocp.transcription, ocp._staged_problem()
-    d, tau = tr.degree, tr.tau
-    n_x, n_th, n_s = prob.n_x, ocp.theta.numel(), len(lock_intervals)
-    h_c = t_grid_end / n_int
-    tau_min = 1e-3 * h_c
-    grid = np.arange(n_int + 1) * h_c
-    K = np.array(lock_intervals)
-    n_nodes, n_ints = K + 2, K + 1
-    X = [ca.MX.sym(f"X{s}", n_x, int(n_nodes[s])) for s in range(n_s)]
-    Xc = [ca.MX.sym(f"Xc{s}", n_x, int(n_ints[s]) * d) for s in range(n_s)]
-    V = ca.MX.sym("V", n_int + 1)
-    tau_s = ca.MX.sym("tau", n_s)
-    z = ca.MX.sym("z", 1 if aggregate in ("worst", "worst_jump") else 0)
+def _robust_nlp(ocp, aggregate, t_grid_end, n_int, lock_intervals):
+    """The robust NLP on the functions of ``ocp`` (see :class:`RobustNLP`): every scenario transcribed
+    under the shared command (:class:`~clutchocp.optimal.scenarios.SharedCommandCollocation`), then the
+    aggregate of their objectives (mean, worst, worst jump; epigraph rows)."""
+    tr = ocp.transcription
+    n_s = len(lock_intervals)
     W = ca.MX.sym("weights", len(OBJECTIVE_TERMS))
-    Theta = ca.MX.sym("theta", n_th, n_s)
+    Theta = ca.MX.sym("theta", ocp.theta.numel(), n_s)
     omega = ca.MX.sym("omega", n_s)
-    w = ca.veccat(*X, *Xc, V, tau_s, z)
-    x_offsets, xc_offsets, start = [], [], 0
-    for s in range(n_s):
-        x_offsets.append((start, int(n_nodes[s])))
-        start += int(n_nodes[s]) * n_x
-    for s in range(n_s):
-        xc_offsets.append((start, int(n_ints[s]) * d))
-        start += int(n_ints[s]) * d * n_x
-    v_slice = slice(start, start + n_int + 1)
-    tau_slice = slice(v_slice.stop, v_slice.stop + n_s)
-
-    # Command and step at every collocation point: interval i < K_s of scenario s is command interval
-    # i (step h_c, u = V_i + (V_{i+1} - V_i) tau_j); its last interval K_s has the step tau_s and
-    # u = V_K + (V_{K+1} - V_K) tau_s tau_j / h_c.
-    left_idx, frac, step = [], [], []
-    for s in range(n_s):
-        for i in range(int(n_ints[s])):
-            left_idx += [i] * d
-            if i < K[s]:
-                frac.append(ca.DM(tau).T)
-                step.append(ca.DM.ones(1, d) * h_c)
-            else:
-                frac.append(tau_s[s] * ca.DM(tau).T / h_c)
-                step.append(ca.repmat(tau_s[s], 1, d))
-    frac, step = ca.horzcat(*frac), ca.horzcat(*step)
-    left = V[left_idx].T
-    right = V[[i + 1 for i in left_idx]].T
-    Uc = left + (right - left) * frac
-    n_pts = len(left_idx)
-    P_pts = ca.vertcat(ca.repmat(W, 1, n_pts),
-                       ca.horzcat(*[ca.repmat(Theta[:, s], 1, int(n_ints[s]) * d) for s in range(n_s)]))
-    xdot, q, c = prob.dynamics.map(n_pts)(ca.horzcat(*Xc), Uc, P_pts)
-
-    B = np.asarray(tr.B)
-    colloc, continuity, g_end, J_s, J_rest, jumps = [], [], [], [], [], []
-    no_jump = np.ones(len(OBJECTIVE_TERMS))
-    no_jump[OBJECTIVE_TERMS.index("jump")] = 0.0
-    col = 0
-    for s in range(n_s):
-        ni = int(n_ints[s])
-        cols = slice(col, col + ni * d)
-        col += ni * d
-        Xs, Xcs = X[s], Xc[s]
-        Cin = _sparse(np.kron(np.eye(ni), tr.C[1:]))
-        Dm = _sparse(np.kron(np.eye(ni), tr.D[1:, None]))
-        C0 = np.repeat(np.tile(tr.C[0], ni)[None, :], n_x, axis=0)
-        hs = step[:, cols]
-        colloc.append(ca.vec(_repeat_columns(Xs[:, :-1], d) * ca.DM(C0) + ca.mtimes(Xcs, Cin)
-                             - ca.repmat(hs, n_x, 1) * xdot[:, cols]))
-        continuity.append(ca.vec(Xs[:, 1:] - (Xs[:, :-1] * tr.D[0] + ca.mtimes(Xcs, Dm))))
-        Q = ca.mtimes(q[:, cols] * ca.repmat(hs, q.size1(), 1), ca.DM(np.tile(B, ni)))
-        T_s = K[s] * h_c + tau_s[s]
-        u_f = V[int(K[s])] + (V[int(K[s]) + 1] - V[int(K[s])]) * tau_s[s] / h_c
-        p_s = ca.vertcat(W, Theta[:, s])
-        J_s.append(prob.objective(Xs[:, -1], u_f, Q, T_s, p_s))
-        if aggregate == "worst_jump":
-            # the scenario's other terms (its jump term off: the worst jump takes its place)
-            J_rest.append(prob.objective(Xs[:, -1], u_f, Q, T_s, ca.vertcat(W * no_jump, Theta[:, s])))
-        jumps.append(ocp.relative_jump_fn(Xs[:, -1], u_f, Theta[:, s]))
-        g_end.append(prob.end(Xs[:, -1], u_f, T_s, p_s))
-    J_all = ca.vertcat(*J_s)
-    n_e = prob.end_lb.size
-    end_lb, end_ub = prob.end_lb.copy(), prob.end_ub.copy()
-    end_lb[-1], end_ub[-1] = -np.inf, np.inf                 # energy row: no e_max in the robust problem
-    # Path constraints at every point but one: with Radau points the last point of a scenario's mesh is
-    # its lock-up node, where the end condition w_rel = 0 holds, and the path row w_rel >= 0 there would
-    # be the same constraint twice (active, with equal gradients: no unique multipliers, and IPOPT met a
-    # singular step computation on the 9-point box).
-    n_c = prob.c_lb.size
-    keep = np.ones((n_pts, n_c), bool)
-    if np.isclose(tau[-1], 1.0):
-        keep[np.cumsum(n_ints * d) - 1, 0] = False
-    keep = np.flatnonzero(keep.ravel())                       # ca.vec(c) runs through the rows of each point
-    blocks = [(ca.vertcat(*colloc), 0.0, 0.0), (ca.vertcat(*continuity), 0.0, 0.0),
-              (ca.vec(c)[keep.tolist()], np.tile(prob.c_lb, n_pts)[keep], np.tile(prob.c_ub, n_pts)[keep]),
-              (ca.vertcat(*g_end), np.tile(end_lb, n_s), np.tile(end_ub, n_s))]
-    if prob.u_rate is not None:
-        limit = float(prob.u_rate[0]) * h_c
-        blocks.append((V[1:] - V[:-1], -limit, limit))
+    z = ca.MX.sym("z", 1 if aggregate in ("worst", "worst_jump") else 0)
+    prob = ocp.staged_problem()                   # its energy end row is free: no e_max in the robust problem
+    # path row 0 (w_rel >= 0) is the end condition w_rel = 0 at a Radau lock-up node
+    grid = SharedCommandCollocation(t_grid_end, n_int, lock_intervals, tr.degree, tr.scheme).transcribe(
+        prob, W, Theta, extra=(z,), end_repeats_path=(0,))
+    J_all = ca.vertcat(*grid.objectives)
+    relative_jump = _relative_jump_fn(ocp)
+    jumps = ca.vertcat(*[relative_jump(x_f, u_f, Theta[:, s]) for s, (x_f, u_f, _, _, _) in enumerate(grid.ends)])
+    blocks = list(grid.blocks)
     if aggregate == "worst":
         f = z
         blocks.append((J_all - z, -np.inf, 0.0))
     elif aggregate == "worst_jump":
+        # the scenarios' other terms (their jump terms off: the worst jump takes their place), and the
         # epigraph of the largest |jump| / locked torque: -z <= jump_s <= z (z >= 0 follows)
-        jump_all = ca.vertcat(*jumps)
+        no_jump = np.ones(len(OBJECTIVE_TERMS))
+        no_jump[OBJECTIVE_TERMS.index("jump")] = 0.0
+        J_rest = [prob.objective(x_f, u_f, Q, T_s, ca.vertcat(W * no_jump, Theta[:, s]))
+                  for s, (x_f, u_f, Q, T_s, _) in enumerate(grid.ends)]
         f = W[OBJECTIVE_TERMS.index("jump")] * z**2 + ca.dot(omega, ca.vertcat(*J_rest))
-        blocks.append((ca.vertcat(jump_all - z, jump_all + z), np.r_[np.full(n_s, -np.inf), np.zeros(n_s)],
+        blocks.append((ca.vertcat(jumps - z, jumps + z), np.r_[np.full(n_s, -np.inf), np.zeros(n_s)],
                        np.r_[np.zeros(n_s), np.full(n_s, np.inf)]))
     else:
         f = ca.dot(omega, J_all)
     g = ca.vertcat(*[b[0] for b in blocks])
     lbg = np.concatenate([np.broadcast_to(b[1], (b[0].numel(),)) for b in blocks])
     ubg = np.concatenate([np.broadcast_to(b[2], (b[0].numel(),)) for b in blocks])
-    assert n_e * n_s == blocks[3][0].numel()
-
-    n_w = w.numel()
-    lbx, ubx = np.full(n_w, -np.inf), np.full(n_w, np.inf)
-    for (a, n) in x_offsets + xc_offsets:
-        lbx[a:a + n * n_x] = np.tile(prob.x_lb, n)
-        ubx[a:a + n * n_x] = np.tile(prob.x_ub, n)
-    for a, _ in x_offsets:                                 # every scenario starts from the initial state
-        lbx[a:a + n_x] = ubx[a:a + n_x] = prob.x0
-    lbx[v_slice], ubx[v_slice] = prob.u_lb[0], prob.u_ub[0]
-    if prob.u_initial is not None and prob.u_rate is not None:
-        lbx[v_slice.start] = ubx[v_slice.start] = prob.u_initial[0]     # no step at t = 0
-    lbx[tau_slice], ubx[tau_slice] = tau_min, h_c
     P = ca.vertcat(W, ca.vec(Theta), omega)
-    nlp = {"x": w, "f": f, "g": g, "p": P}
-    objectives_fn = ca.Function("scenario_objectives", [w, P], [J_all])
-    jumps_fn = ca.Function("scenario_jumps", [w, P], [ca.vertcat(*jumps)])
-    return _RobustNLP(nlp, lbx, ubx, lbg, ubg, x_offsets, xc_offsets, v_slice, tau_slice, n_x, d, np.asarray(tau),
-                      h_c, tuple(int(k) for k in K), grid, objectives_fn, tau_min, jumps_fn)
+    nlp = {"x": grid.w, "f": f, "g": g, "p": P}
+    return RobustNLP(grid, nlp, lbg, ubg, ca.Function("scenario_objectives", [grid.w, P], [J_all]),
+                     ca.Function("scenario_jumps", [grid.w, P], [jumps]))
+
+
+def _relative_jump_fn(ocp):
+    """The jump as a share of the scenario's own locked torque, (locked - slipping) / locked at the end
+    state (the measure of the Monte Carlo): ``(xs, us, theta) -> share`` (the worst-jump epigraph)."""
+    xs, us = ca.SX.sym("xs", ocp.x0.size + 1), ca.SX.sym("us")
+    fns = ocp.phase_functions["slip"]
+    values = fns["outputs_fn"](xs, us, *([ocp.theta] if ocp.theta.numel() else []))
+    locked = values[fns["output_names"].index("locked_torque_Nm")]
+    slipping = values[fns["output_names"].index("total_torque_Nm")]
+    return ca.Function("relative_jump", [xs, us, ocp.theta], [(locked - slipping) / locked])
 
 
 def lock_diagonal(scene, corners, fractions=DIAGONAL_FRACTIONS):

@@ -15,7 +15,7 @@ import numpy as np
 from ..simulation import SimulationOptions
 from ..simulation.locate import root_near
 from .guess import DISSIPATED, engagement_samples
-from .replay import CommandModel, simulate_command
+from .replay import simulate_command
 
 LOCK_TIME_TOLERANCE = 0.01      # relative
 JUMP_TOLERANCE = 0.02           # relative to the torque carried after lock-up (or the peak torque, see above)
@@ -112,7 +112,8 @@ def verify(ocp, opt, *, model=None, rtol=None, atol=None):
     ocp : clutchocp.optimal.problem.EngagementOCP
     opt : clutchocp.optimal.problem.OptimalEngagement
     model : clutchocp.optimal.replay.CommandModel, optional
-        A command model of the scene already built (same control kind).
+        A command model of the scene already built (same control kind; default: the problem's,
+        ``ocp.models``).
     rtol, atol : float, optional
         IDAS tolerances (default: the scene's).
 
@@ -121,7 +122,7 @@ def verify(ocp, opt, *, model=None, rtol=None, atol=None):
     (dict, clutchocp.engagement.run.EngagementResult)
         The comparison (JSON-ready) and the IDAS run.
     """
-    model = model or CommandModel(ocp.scene, opt.control)
+    model = model or ocp.models.replay(opt.control)
     t_f = opt.t_f
     # The hold starts a little after t_f: a lock-up located exactly on an input break (IDAS finds it
     # at t_f within the event tolerance) made the engine skip that break and keep the last ramp.

@@ -14,6 +14,8 @@ import casadi as ca
 import numpy as np
 from scipy import integrate, special
 
+from clutchocp.simulation.vectorized import register_table
+
 from .backend import apply_elementwise, erfc, exp, fmax, fmin, if_else, is_symbolic, log, softplus, sqrt
 
 __all__ = [
@@ -111,6 +113,7 @@ def _f52_quadrature(H):
 _GRID = np.linspace(_H_LO, _H_HI, round((_H_HI - _H_LO) / _H_STEP) + 1)
 _LOG_TABLE = np.log([_f52_quadrature(H) for H in _GRID])
 _LOG_F52_SPLINE = ca.interpolant("log_F52", "bspline", [_GRID.tolist()], _LOG_TABLE.tolist())
+register_table(_LOG_F52_SPLINE, _GRID)      # outputs and events on many samples: numpy, not de Boor per sample
 
 # H -> -inf: F_{5/2}(H) = E[(s + a)^{5/2}], a = -H, = a^{5/2} sum_k C(5/2, 2k) (2k-1)!! a^{-2k}.
 _LO_COEFFS = [special.binom(2.5, 2 * k) * math.prod(range(1, 2 * k, 2)) for k in range(6)]

@@ -27,6 +27,7 @@ from clutchocp.physics import transmitted_shear_table
 from clutchocp.physics.backend import (apply_elementwise, exp, fmax, fmin, if_else, is_symbolic, log,
                                        softplus, smooth_step)
 from clutchocp.physics.roughness import average_gap, combined_sigma
+from clutchocp.simulation.vectorized import register_table
 
 EPS_STAR = 1.0 / 300.0          # Cui 2019 after Eq. 6: eps* = 0.00333 (cut-off film / 3 sigma)
 
@@ -231,6 +232,7 @@ _TABLE_Y = np.concatenate([[FAR_FIELD_TRANSMITTED],
                            ((np.asarray(transmitted_shear_table.PHI_T) - 1.0)
                             * (1.0 + np.asarray(transmitted_shear_table.H)) ** 2)[::-1]])
 _TRANSMITTED_SPLINE = ca.interpolant("transmitted_y", "bspline", [_TABLE_U.tolist()], _TABLE_Y.tolist())
+register_table(_TRANSMITTED_SPLINE, _TABLE_U)   # numpy-translated models evaluate it with numpy
 
 
 def transmitted_shear_factor(H, method="patir_cheng", smooth=False, smooth_cutoff=False, width=0.05):

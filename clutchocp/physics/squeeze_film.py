@@ -16,7 +16,7 @@ E_c = rho (3 w1^2 + 3 w2^2 + 4 w1 w2) / (20 phi_r).  With p(r1) = P0 and p(r2) =
 W > 0 pushes the plates apart: squeezing (h_T' < 0) makes E_s < 0 and W > 0; centrifugal
 pumping (E_c > 0) sucks the film and lowers W (Liao's "- F2").
 
-Errata found in the seeds (derived and tested in tests/test_squeeze_film.py):
+Errata found in the seeds (derived and tested in tests/physics/test_squeeze_film.py):
 - Zhang 2021 Eq. 4 writes (b^2 - a^2) / (2 ln(a/b)); the factor 2 is wrong (then p(r1) != 0).
 - Liao 2021 Eq. 7 (F3 = 3 pi mu G delta' / delta^3) lacks the factor 1/2 of W above.
 - Bao 2020 Eq. 12 (the expanded load) is not readable as printed; W above is the exact

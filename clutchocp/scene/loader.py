@@ -5,7 +5,6 @@ file.  Validation turns every user mistake into one :class:`~clutchocp.errors.Sc
 names the field and what is allowed.
 """
 
-import difflib
 import math
 import tomllib
 from pathlib import Path
@@ -23,10 +22,11 @@ from ..errors import (
 )
 from ..physics.friction import CHEN_THETA_MIN
 from ..physics.viscosity import walther_coefficients, walther_kinematic_viscosity
-from ..units import to_si
-from .schema import CHECKS, PARTS, REQUIRED_PARTS
+from .fields import check_value, parse_field, suggest  # noqa: F401 - check_value: engagement.run reads it here
+from .schema import PARTS, REQUIRED_PARTS
+from .uncertainty import Uncertainty
 
-# The table of a scene that declares its uncertain fields (see clutchocp.uncertainty), not a part.
+# The table of a scene that declares its uncertain fields (see clutchocp.scene.uncertainty), not a part.
 UNCERTAINTY = "uncertainty"
 
 # Parts each static analysis reads.
@@ -72,7 +72,7 @@ def read_toml(name_or_path, folder, what):
             names = sorted(p.stem for p in builtin_dir(folder).glob("*.toml"))
             raise SceneNotFoundError(
                 f"{what} '{name_or_path}': no such file and no built-in {what} of that name"
-                f"{_suggest(str(name_or_path), names)} (built-in: {', '.join(names)})"
+                f"{suggest(str(name_or_path), names)} (built-in: {', '.join(names)})"
             )
         path = candidate
     try:
@@ -81,81 +81,6 @@ def read_toml(name_or_path, folder, what):
         raise SceneError(f"{path.name}: not valid TOML ({exc})") from None
     except UnicodeDecodeError:
         raise SceneError(f"{path.name}: not a UTF-8 text file") from None
-
-
-def _suggest(word, options):
-    """"; did you mean 'x'?" for the closest of ``options``, or an empty string."""
-    close = difflib.get_close_matches(word, list(options), n=1, cutoff=0.5)
-    return f"; did you mean '{close[0]}'?" if close else ""
-
-
-def _check_value(name, value, spec, unit_hint):
-    ok, phrase = CHECKS[spec.check]
-    if not math.isfinite(value):
-        raise PhysicalRangeError(f"{name} = {value}: must be a finite number {phrase}")
-    if not ok(value):
-        raise PhysicalRangeError(f"{name} = {value:g}{unit_hint}: must be {phrase}")
-
-
-def check_value(name, value, spec):
-    """Check an SI value given outside a scene file (an API argument) as the scene field ``spec`` would.
-
-    Raises ParameterTypeError (not a number, or not a whole number for an int field) or
-    PhysicalRangeError (outside the field's range), naming ``name``.
-    """
-    whole = spec.kind == "int"
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or \
-            (whole and not float(value).is_integer()):
-        raise ParameterTypeError(f"{name} = {value!r}: expected {'a whole number' if whole else 'a number'}")
-    _check_value(name, float(value), spec, "" if spec.dim == "1" else f" ({spec.dim})")
-
-
-def parse_field(name, raw, spec, density=None):
-    """Convert one raw TOML value to its SI value, or raise a one-line SceneError.
-
-    ``density`` [kg/m^3] converts a kinematic viscosity (cSt) given for a dynamic one.
-    """
-    unit_hint = "" if spec.dim == "1" else f" (SI, {spec.dim})"
-    if spec.kind == "quantity":
-        if isinstance(raw, (list, dict)):
-            raise ParameterTypeError(f"{name}: expected one number or quantity in {spec.dim}, got a {type(raw).__name__}")
-        value = to_si(raw, spec.dim, name, density=density)
-        _check_value(name, value, spec, unit_hint)
-        return value
-    if spec.kind == "quantity_list":
-        items = raw if isinstance(raw, list) else [raw]
-        if not items:
-            raise ParameterTypeError(f"{name}: expected at least one value in {spec.dim}")
-        values = []
-        for i, item in enumerate(items):
-            if isinstance(item, (list, dict)):
-                raise ParameterTypeError(f"{name}[{i}]: expected a number or quantity in {spec.dim}")
-            value = to_si(item, spec.dim, f"{name}[{i}]")
-            _check_value(f"{name}[{i}]", value, spec, unit_hint)
-            values.append(value)
-        return np.array(values)
-    if spec.kind == "int":
-        if isinstance(raw, bool) or not isinstance(raw, int):
-            raise ParameterTypeError(f"{name}: expected a whole number, got {raw!r}")
-        _check_value(name, raw, spec, "")
-        return raw
-    if spec.kind == "bool":
-        if not isinstance(raw, bool):
-            raise ParameterTypeError(f"{name}: expected true or false, got {raw!r}")
-        return raw
-    if spec.kind == "str":
-        if not isinstance(raw, str):
-            raise ParameterTypeError(f"{name}: expected text, got {raw!r}")
-        return raw
-    if spec.kind == "str_list":
-        if not isinstance(raw, list) or not all(isinstance(x, str) for x in raw):
-            raise ParameterTypeError(f"{name}: expected a list of text lines")
-        return tuple(raw)
-    if spec.kind == "choice":
-        if raw not in spec.choices:
-            raise UnknownVariantError(f"{name} = {raw!r}: allowed values are {', '.join(spec.choices)}")
-        return raw
-    raise AssertionError(f"schema error: unknown field kind {spec.kind}")
 
 
 def _validate_part(part_name, table):
@@ -169,7 +94,7 @@ def _validate_part(part_name, table):
         if not isinstance(variant, str) or variant not in part.variants:
             raise UnknownVariantError(
                 f"{part_name}.model = {variant!r}: unknown variant; allowed: {', '.join(part.variants)}"
-                + (_suggest(variant, part.variants) if isinstance(variant, str) else "")
+                + (suggest(variant, part.variants) if isinstance(variant, str) else "")
             )
         values["model"] = variant
     allowed = part.allowed_fields(variant)
@@ -180,7 +105,7 @@ def _validate_part(part_name, table):
             where = f"{part_name} (model = {variant})" if variant else part_name
             options = sorted(allowed) + (["model"] if part.variants else [])
             raise UnknownKeyError(
-                f"{part_name}.{key}: unknown key in [{where}]{_suggest(key, options)} "
+                f"{part_name}.{key}: unknown key in [{where}]{suggest(key, options)} "
                 f"(allowed: {', '.join(options)})"
             )
     # the density first: a viscosity given in cSt is converted with it (mu = rho nu)
@@ -378,7 +303,7 @@ class Scene:
             if not dot or not key:
                 raise UnknownKeyError(f"{name}: an override is written part.key=value (e.g. oil.viscosity=0.04)")
             if part not in PARTS:
-                raise UnknownKeyError(f"{name}: unknown part '{part}'{_suggest(part, PARTS)}")
+                raise UnknownKeyError(f"{name}: unknown part '{part}'{suggest(part, PARTS)}")
             if value is None:
                 raw.get(part, {}).pop(key, None)
             else:
@@ -387,13 +312,11 @@ class Scene:
 
     @property
     def uncertainty(self):
-        """The spread of the clutches this scene stands for (:class:`clutchocp.uncertainty.Uncertainty`,
+        """The spread of the clutches this scene stands for (:class:`clutchocp.scene.uncertainty.Uncertainty`,
         empty if the scene has no ``[uncertainty]`` table). Read when first asked for, so that a
         deterministic run of a scene whose overrides change a part (e.g. ``load.model``) does not
         depend on it; studies that use it check it first (``Uncertainty.from_scene``)."""
         if self._uncertainty is None:
-            from ..uncertainty import Uncertainty
-
             try:
                 self._uncertainty = Uncertainty.from_scene(self, check=False)
             except SceneError as exc:
@@ -438,7 +361,7 @@ def validate(raw, base_dir):
     raw = {part: table for part, table in raw.items() if part != UNCERTAINTY}
     for part in raw:
         if part not in PARTS:
-            raise UnknownKeyError(f"[{part}]: unknown part{_suggest(part, PARTS)} "
+            raise UnknownKeyError(f"[{part}]: unknown part{suggest(part, PARTS)} "
                                   f"(allowed: {', '.join(PARTS)}, {UNCERTAINTY})")
     if "scene" not in raw:
         raise MissingParameterError("[scene]: missing part (name, source and kind are required)")

@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 from ..engagement.run import EngagementResult, summarize
+from ..optimal.clamp import extend_to_clamp
 from ..optimal.replay import CommandModel, simulate_command
 from ..simulation import SimulationOptions, simulate
 from ..simulation.result import SimulationResult
@@ -23,28 +24,12 @@ POINTS_PER_SAMPLE = 11       # output points per TCU sample (1 ms at 10 ms) for 
 def post_lock_command(scene, times, values, t_lock, rate_limit):
     """The command continued after lock-up: (times, values) [s], [Pa], piecewise linear.
 
-    The clamp ramp of the robust optimisation (``clutchocp.optimal.clamp.extend_to_clamp``) when it is
-    installed; otherwise the command up to ``t_lock`` followed by a ramp at ``rate_limit`` [Pa/s] to
-    the holding pressure, the larger of the command at lock-up and the scene's set pressure (as the
-    verification of an optimum holds a locked clutch, :func:`clutchocp.optimal.verify.holding_pressure`).
+    The command up to ``t_lock`` followed by a ramp at ``rate_limit`` [Pa/s] to the clamp pressure
+    (:func:`clutchocp.optimal.clamp.extend_to_clamp`, as the robust optimisation continues its command).
     """
     times, values = np.asarray(times, float), np.asarray(values, float)
-    try:
-        from ..optimal.clamp import extend_to_clamp
-    except ImportError:
-        extend_to_clamp = None
-    if extend_to_clamp is not None:
-        t_out, p_out = extend_to_clamp(scene, times, values, t_lock, rate_limit=rate_limit)
-        return np.asarray(t_out, float), np.asarray(p_out, float)
-    u_lock = float(np.interp(t_lock, times, values))
-    keep = times < t_lock
-    p_hold = max(u_lock, scene.value("actuation.pressure"))
-    p_max = scene.get("actuation.max_pressure")
-    if p_max is not None:
-        u_lock, p_hold = min(u_lock, p_max), min(p_hold, p_max)
-    ramp = max((p_hold - u_lock) / rate_limit, 1e-6)
-    return (np.concatenate([times[keep], [t_lock, t_lock + ramp]]),
-            np.concatenate([values[keep], [u_lock, p_hold]]))
+    t_out, p_out = extend_to_clamp(scene, times, values, t_lock, rate_limit=rate_limit)
+    return np.asarray(t_out, float), np.asarray(p_out, float)
 
 
 def _options(scene, rtol=None, atol=None):

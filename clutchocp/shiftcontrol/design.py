@@ -6,7 +6,7 @@
    dynamics (:class:`~clutchocp.shiftcontrol.linearize.SlipLinearization`) and the output rows
    C_w (slip) and C_a (slip rate) at t_k.
 3. Augment with the slip-error integral xi_{k+1} = xi_k + Ts C_w dx_k and solve the finite-horizon
-   time-varying LQR (:func:`~clutchocp.shiftcontrol.tvlqr.tvlqr`) with the weights of the spec on
+   time-varying LQR (:func:`~clutchocp.control.lqr.tvlqr`) with the weights of the spec on
    scaled deviations (Bryson's rule): slip error / w_rel(0), slip-rate error / (w_rel(0) / t_lock),
    integral / (w_rel(0) t_lock), correction / pressure range; the terminal weight at lock-up is
    ``terminal_weight`` times the state weight there (a slip rate held at its nominal value at
@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..control.lqr import tvlqr
 from ..engagement.run import EngagementResult
 from ..errors import ModelError
 from ..optimal.guess import SLIP_MODE
@@ -30,7 +31,6 @@ from ..optimal.replay import CommandModel, simulate_command
 from .controller import SlipFeedback
 from .estimator import FeedforwardAdaptation, TorqueEstimator
 from .linearize import SlipLinearization
-from .tvlqr import tvlqr
 
 SUBSTEPS = 8            # sub-intervals per sample for the sample maps
 
@@ -139,29 +139,8 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
     C_end = lin.continuous(x_slip[-1], ff(t_slip[-1]), z_slip[-1])[2]
     sig = {name: j for j, name in enumerate(lin.signals)}
 
-    # weights on scaled deviations
-    w = spec.lqi
     w_rel0 = lin.signal_values(state_at(0.0), ff(0.0), alg_at(0.0))["w_rel"]
-    e_s, r_s, xi_s, p_s = abs(w_rel0), abs(w_rel0) / t_lock, abs(w_rel0) * t_lock, p_hi - p_lo
-
-    def state_weight(C):
-        Cw, Ca = C[sig["w_rel"]][None, :], C[sig["slip_rate"]][None, :]
-        Q = np.zeros((n + 1, n + 1))
-        Q[:n, :n] = (Cw.T @ Cw / (w["slip_tolerance"] * e_s) ** 2
-                     + Ca.T @ Ca / (w["slip_rate_tolerance"] * r_s) ** 2)
-        Q[n, n] = 1.0 / (w["integral_tolerance"] * xi_s) ** 2
-        return Q
-
-    A_aug, B_aug, Q = [], [], []
-    for k in range(N):
-        A = np.eye(n + 1)
-        A[:n, :n] = Phi[k]
-        A[n, :n] = (ends[k] - starts[k]) * rows[k][sig["w_rel"]]
-        A_aug.append(A)
-        B_aug.append(np.vstack([Gamma[k], [[0.0]]]))
-        Q.append(state_weight(rows[k]))
-    R = [np.array([[1.0 / (w["correction_tolerance"] * p_s) ** 2]])] * N
-    K, P = tvlqr(A_aug, B_aug, Q, R, w["terminal_weight"] * state_weight(C_end))
+    K, P = _slip_lqr(spec.lqi, sig, Phi, Gamma, rows, C_end, ends - starts, w_rel0, t_lock, p_hi - p_lo)
 
     # realisation from the measured signals
     measured = ["slip_rate"] + [s for s in ("w_in", "w_out") if s in sig]
@@ -173,22 +152,8 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
         Cy = rows[k][[sig[m] for m in measured]]
         gains[k] = K[k, 0, :n] @ S @ np.linalg.pinv(Cy @ S)
     sample_times = np.arange(N + 1) * Ts
-    ref = np.zeros((N + 1, len(measured)))
-    slip_ref = np.zeros(N + 1)
-    for k, t in enumerate(sample_times):
-        t_in = min(t, t_slip[-1])
-        values_k = lin.signal_values(state_at(t_in), ff(t), alg_at(t_in))
-        slip_ref[k] = values_k["w_rel"] if t < t_lock else 0.0
-        for j, name in enumerate(measured):
-            ref[k, j] = values_k[name] if name != "slip_rate" else 0.0
-    ref[0, 0] = lin.signal_values(state_at(0.0), ff(0.0), alg_at(0.0))["slip_rate"]
-    ref[1:, 0] = np.diff(slip_ref) / Ts            # the TCU's difference rate of the nominal slip
-    if N >= 1:
-        # at t_N the nominal clutch is locked: both speeds at the common speed just after lock-up
-        lock = next(e for e in nominal.result.events if e.name == "lockup")
-        for j, name in enumerate(measured):
-            if name in ("w_in", "w_out"):
-                ref[N, j] = lock.x_after[name]
+    ref, slip_ref = _references(lin, measured, sample_times, Ts, t_lock, t_slip[-1], state_at, alg_at, ff,
+                                 nominal)
     path = None
     if spec.progress == "slip":
         w_slip = np.array([lin.signal_values(x, ff(t), z)["w_rel"] for t, x, z in zip(t_slip, x_slip, z_slip)])
@@ -205,6 +170,63 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
                             max_delay=spec.max_delay, adaptation=adaptation)
     return SlipFeedbackDesign(feedback, nominal, t_lock, sample_times, Phi, Gamma, K, P, lin.state_names, spec,
                               adaptation_off)
+
+
+def _slip_lqr(w, sig, Phi, Gamma, rows, C_end, durations, w_rel0, t_lock, p_range):
+    """Gains and cost-to-go of the time-varying LQR on the sample maps augmented with the slip-error integral.
+
+    Weights on scaled deviations (Bryson's rule, see the module docstring): ``w`` the spec's [lqi] table,
+    ``sig`` the row of each signal in the output matrices ``rows`` (per sample) and ``C_end`` (at lock-up),
+    ``durations`` the sample lengths [s], ``w_rel0`` the initial slip [rad/s], ``p_range`` [Pa].
+    """
+    n = Phi.shape[1]
+    e_s, r_s, xi_s, p_s = abs(w_rel0), abs(w_rel0) / t_lock, abs(w_rel0) * t_lock, p_range
+
+    def state_weight(C):
+        Cw, Ca = C[sig["w_rel"]][None, :], C[sig["slip_rate"]][None, :]
+        Q = np.zeros((n + 1, n + 1))
+        Q[:n, :n] = (Cw.T @ Cw / (w["slip_tolerance"] * e_s) ** 2
+                     + Ca.T @ Ca / (w["slip_rate_tolerance"] * r_s) ** 2)
+        Q[n, n] = 1.0 / (w["integral_tolerance"] * xi_s) ** 2
+        return Q
+
+    A_aug, B_aug, Q = [], [], []
+    for k in range(len(Phi)):
+        A = np.eye(n + 1)
+        A[:n, :n] = Phi[k]
+        A[n, :n] = durations[k] * rows[k][sig["w_rel"]]
+        A_aug.append(A)
+        B_aug.append(np.vstack([Gamma[k], [[0.0]]]))
+        Q.append(state_weight(rows[k]))
+    R = [np.array([[1.0 / (w["correction_tolerance"] * p_s) ** 2]])] * len(Phi)
+    return tvlqr(A_aug, B_aug, Q, R, w["terminal_weight"] * state_weight(C_end))
+
+
+def _references(lin, measured, sample_times, Ts, t_lock, t_last, state_at, alg_at, ff, nominal):
+    """The measured signals' and the slip's values on the nominal trajectory at the TCU samples.
+
+    ``sample_times`` are t_0 .. t_N, ``Ts`` apart [s]; ``t_last`` is the last slipping time of the nominal
+    run; ``state_at``, ``alg_at`` and ``ff`` give its states, algebraic values and the feedforward at a time.
+    Returns (ref (N + 1, len(measured)), slip_ref (N + 1)).
+    """
+    N = len(sample_times) - 1
+    ref = np.zeros((N + 1, len(measured)))
+    slip_ref = np.zeros(N + 1)
+    for k, t in enumerate(sample_times):
+        t_in = min(t, t_last)
+        values_k = lin.signal_values(state_at(t_in), ff(t), alg_at(t_in))
+        slip_ref[k] = values_k["w_rel"] if t < t_lock else 0.0
+        for j, name in enumerate(measured):
+            ref[k, j] = values_k[name] if name != "slip_rate" else 0.0
+    ref[0, 0] = lin.signal_values(state_at(0.0), ff(0.0), alg_at(0.0))["slip_rate"]
+    ref[1:, 0] = np.diff(slip_ref) / Ts            # the TCU's difference rate of the nominal slip
+    if N >= 1:
+        # at t_N the nominal clutch is locked: both speeds at the common speed just after lock-up
+        lock = next(e for e in nominal.result.events if e.name == "lockup")
+        for j, name in enumerate(measured):
+            if name in ("w_in", "w_out"):
+                ref[N, j] = lock.x_after[name]
+    return ref, slip_ref
 
 
 def _adaptation_unavailable(scene, state_names):

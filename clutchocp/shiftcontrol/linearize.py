@@ -3,7 +3,7 @@
 In the forward-slip mode of the exact engagement model (:class:`~clutchocp.engagement.model.EngagementModel`,
 ``smooth=False``) with the pressure command u as input, dx/dt = f(x, z, u), 0 = g(x, z, u). At a
 point of a trajectory CasADi gives the Jacobians exactly and the algebraic variables (the hub speed
-of a compliant shaft) are eliminated (:func:`clutchocp.hvd.linearize.eliminate_algebraic`):
+of a compliant shaft) are eliminated (:mod:`clutchocp.control.linearize`):
 
     d(dx)/dt = A(t) dx + B(t) du,    dy = C(t) dx + D(t) du
 
@@ -22,8 +22,8 @@ import casadi as ca
 import numpy as np
 from scipy.linalg import expm
 
+from ..control.linearize import jacobian_function, linear_model
 from ..errors import ModelError
-from ..hvd.linearize import eliminate_algebraic
 from ..optimal.guess import SLIP_MODE
 
 #: Signals of the slip phase that the linearisation gives output rows for.
@@ -71,13 +71,10 @@ class SlipLinearization:
                 signals[name] = mode.x[name]
         self.signals = tuple(signals)
         c = ca.vertcat(*signals.values())
-        blocks = []
-        for expr in (f, g, c):
-            blocks += [ca.jacobian(expr, x), ca.jacobian(expr, z), ca.jacobian(expr, u)]
         if ca.depends_on(ca.vertcat(f, g, c), engagement.t):
             raise ModelError("slip linearisation: the slip mode depends on time explicitly (a pressure profile, "
                              "not a command)")
-        self._jacobians = ca.Function("slip_jacobians", [x_all, z, u], blocks)
+        self._jacobians = jacobian_function("slip_jacobians", [x_all, z, u], x, z, u, f, g, c)
         self._signals = ca.Function("slip_signals", [x_all, z, u], [c])
         self.nominal = np.array([mode.x_nominal[list(mode.x).index(n)] for n in self.state_names])
 
@@ -100,9 +97,7 @@ class SlipLinearization:
         A is (n, n), B (n, 1), C (len(signals), n), D (len(signals), 1); algebraic variables eliminated.
         """
         x, z = self._point(x, z)
-        fx, fz, fu, gx, gz, gu, cx, cz, cu = (np.array(m, dtype=float) for m in self._jacobians(x, z, u))
-        (A, B), (C, D) = eliminate_algebraic(gx, gz, gu, (fx, fz, fu), (cx, cz, cu))
-        return A, B, C, D
+        return linear_model(self._jacobians, x, z, u)
 
     def signal_values(self, x, u, z=None):
         """The signals (w_rel, slip_rate, ...) at a point, SI (dict)."""

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..optimal.replay import CommandModel
 from ..optimal.verify import LOCK_TIME_TOLERANCE, run_numbers
+from ..scene.loader import Scene
 from .closed_loop import run_closed_loop, run_open_loop
 
 HISTORY_STEP = 0.002          # [s] grid of the time histories kept for the envelope figures
@@ -47,7 +48,6 @@ class Strategy:
 
 def _scene(task, overrides):
     """The scene of a task (its raw tables and file path: plain data) with overrides."""
-    from ..scene.loader import Scene
     return Scene(task["scene_raw"], task["scene_path"]).with_overrides(dict(overrides))
 
 

@@ -106,7 +106,7 @@ def design_schedule(scene, spec, uncertainty, feedforward_for, *, say=print):
     scene : clutchocp.scene.Scene
         The nominal scene.
     spec : SlipControlSpec
-    uncertainty : clutchocp.uncertainty.Uncertainty
+    uncertainty : clutchocp.scene.uncertainty.Uncertainty
     feedforward_for : callable
         ``feedforward_for(design_scene) -> (times [s], command [Pa])``: the feedforward of a design scene.
     say : callable

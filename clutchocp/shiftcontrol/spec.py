@@ -1,6 +1,6 @@
 """The slip-feedback specification (controllers/slip_lqr.toml): TCU sampling, limits, LQI weights.
 
-Validated like the speed-controller specs of :mod:`clutchocp.hvd.spec` (same table parser); every
+Validated like the speed-controller specs of :mod:`clutchocp.hvd.spec` (:mod:`clutchocp.control.spec`); every
 mistake raises a :class:`~clutchocp.errors.SceneError` subclass whose one-line message names the
 field::
 
@@ -40,9 +40,8 @@ field::
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import MissingParameterError, ParameterTypeError, PhysicalRangeError, UnknownKeyError
-from ..hvd.spec import _table, read_spec
-from ..scene.loader import _suggest
+from ..control.spec import check_tables, parse_table, read_spec
+from ..errors import MissingParameterError, PhysicalRangeError
 
 TYPES = ("slip_lqi",)
 ANTI_WINDUP = ("clamping", "none")
@@ -121,17 +120,13 @@ def load_slip_spec(name_or_path="slip_lqr"):
 
 def parse_slip_spec(raw):
     """Validate a parsed slip-feedback spec (a dict of TOML tables); return a :class:`SlipControlSpec`."""
-    if not isinstance(raw, dict):
-        raise ParameterTypeError("slip feedback spec: expected TOML tables")
-    for table in raw:
-        if table not in _TABLES:
-            raise UnknownKeyError(f"[{table}]: unknown table{_suggest(table, _TABLES)} (allowed: {', '.join(_TABLES)})")
+    check_tables(raw, _TABLES, "slip feedback spec")
     if "controller" not in raw:
         raise MissingParameterError("[controller]: missing table (type and sample_time are required)")
     for key in _REQUIRED:
         if isinstance(raw["controller"], dict) and key not in raw["controller"]:
             raise MissingParameterError(f"controller.{key}: missing required parameter")
-    values = {name: _table(name, raw.get(name, {}), schema) for name, schema in _TABLES.items()}
+    values = {name: parse_table(name, raw.get(name, {}), schema) for name, schema in _TABLES.items()}
     c = values["controller"]
     if c["pressure_min"] is not None and c["pressure_max"] is not None and c["pressure_min"] >= c["pressure_max"]:
         raise PhysicalRangeError(f"controller.pressure_min = {c['pressure_min']:g} Pa must be below "

@@ -7,7 +7,8 @@ See ``README-engine.md`` in this folder.
 """
 
 from clutchocp.simulation.driver import simulate
-from clutchocp.simulation.model import Event, HybridModel, Mode, PiecewiseConstant, time_derivative
+from clutchocp.simulation.derivative import time_derivative
+from clutchocp.simulation.model import Event, HybridModel, Mode, PiecewiseConstant
 from clutchocp.simulation.options import METHODS, SimulationOptions
 from clutchocp.simulation.result import EventRecord, Segment, SimulationResult
 

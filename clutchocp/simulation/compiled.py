@@ -15,8 +15,10 @@ import casadi as ca
 import numpy as np
 
 from clutchocp.errors import ModelError, SolverError
-from clutchocp.simulation.model import time_derivative
+from clutchocp.simulation.derivative import time_derivative
 from clutchocp.simulation import vectorized
+from clutchocp.simulation.diagnostics import solver_error
+from clutchocp.simulation.native import compile_columns, native_dae
 from clutchocp.simulation.vectorized import MIN_SAMPLES, numpy_function, padded_size
 
 
@@ -73,8 +75,7 @@ class ColumnFunction:
         self.n_out = function.size1_out(0)
         self._maps = {}
         self._max_maps = max_maps
-        self._calls = function.is_a("SXFunction") and any(
-            function.instruction_id(k) == ca.OP_CALL for k in range(function.n_instructions()))
+        self._calls = vectorized.calls_unregistered(function)
         self._numpy_built = False
         self._numpy_fn = None
         self._loop = loop
@@ -265,7 +266,6 @@ class CompiledMode:
     def native_dae(self):
         """``dae_tau`` compiled to machine code (see :mod:`clutchocp.simulation.native`), or None."""
         if self._native_dae is None:
-            from clutchocp.simulation.native import native_dae
             self._native_dae = native_dae(self) or False
         return self._native_dae or None
 
@@ -298,7 +298,6 @@ class CompiledMode:
             calls = any(f.instruction_id(k) == ca.OP_CALL for k in range(f.n_instructions()))
             compiled = None
             if calls:
-                from clutchocp.simulation.native import compile_columns
                 compiled = compile_columns(f)
             self._native_events_on = ColumnFunction(compiled[0], loop=compiled[1]) if compiled is not None \
                 else self.events_on
@@ -319,7 +318,6 @@ class CompiledMode:
         if self._native_events_outputs is None:
             merged = None
             if self.events and self.event_values(True) is not self.events_on:
-                from clutchocp.simulation.native import compile_columns
                 args = [self.xs, self.zs, self.pu, self.t]
                 both = ca.Function(f"{self.name}_events_outputs", args,
                                    [ca.densify(ca.cse(ca.vertcat(self.f_events(*args), self.f_outputs(*args))))])
@@ -331,7 +329,6 @@ class CompiledMode:
     def native_outputs_on(self):
         """:attr:`outputs_on` with the outputs compiled to machine code (itself if that fails)."""
         if self._native_outputs_on is None:
-            from clutchocp.simulation.native import compile_columns
             compiled = compile_columns(self.f_outputs)
             self._native_outputs_on = ColumnFunction(compiled[0], loop=compiled[1]) if compiled is not None \
                 else self.outputs_on
@@ -356,7 +353,6 @@ class CompiledMode:
         zs = np.array(rf(guess, xs, pu, t), dtype=float).ravel()
         if not (rf.stats()["success"] and np.all(np.isfinite(zs))):
             residual = np.array(self.f_alg(xs, zs, pu, t), dtype=float).ravel()
-            from clutchocp.simulation.diagnostics import solver_error
             raise solver_error("the consistent-initialisation Newton solve", "no_convergence", t, self,
                                xs, zs, detail=f"; largest scaled residual {np.max(np.abs(residual)):.3g}")
         return zs

@@ -47,6 +47,10 @@ HINTS["wall_time"] = (("the wall-time limit (SimulationOptions.max_wall_time) wa
                        "stiff, badly scaled or switching modes very often here"),
                       ("look at the states named here for a vanishing gap or a huge scale, loosen rtol/atol, or "
                        "raise max_wall_time"))
+# CVODES's flags whose IDAS counterpart has another name (the rest differ only in the prefix)
+CVODES_AS_IDAS = {"CV_CONV_FAILURE": "IDA_CONV_FAIL", "CV_ERR_FAILURE": "IDA_ERR_FAIL",
+                  "CV_RHSFUNC_FAIL": "IDA_RES_FAIL", "CV_REPTD_RHSFUNC_ERR": "IDA_REP_RES_ERR",
+                  "CV_FIRST_RHSFUNC_ERR": "IDA_FIRST_RES_FAIL", "CV_UNREC_RHSFUNC_ERR": "IDA_RES_FAIL"}
 _DEFAULT = ("the integrator stopped", "tighten or loosen the tolerances, check the scales and the model")
 
 
@@ -67,7 +71,8 @@ def largest_scaled(names, scaled, nominal, count=3):
 
 def solver_error(solver, flag, t, cm, xs, zs=None, detail=""):
     """Build a :class:`~clutchocp.errors.SolverError` for a failure at time ``t`` in mode ``cm``."""
-    why, remedy = HINTS.get(flag) or HINTS.get(str(flag).replace("CV_", "IDA_", 1), _DEFAULT)
+    flag_as_idas = CVODES_AS_IDAS.get(flag) or str(flag).replace("CV_", "IDA_", 1)
+    why, remedy = HINTS.get(flag) or HINTS.get(flag_as_idas, _DEFAULT)
     where = f"Largest scaled states: {largest_scaled(cm.x_names, xs, cm.x_nominal)}"
     if zs is not None and cm.nz:
         where += f"; algebraic: {largest_scaled(cm.z_names, zs, cm.z_nominal)}"

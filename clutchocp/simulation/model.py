@@ -8,7 +8,7 @@ piecewise-constant inputs ``u`` and time ``t`` (CasADi SX scalars). Each mode is
 with its own named differential states ``x`` and algebraic variables ``z`` (each with a
 nominal scale), named outputs, and :class:`Event` objects that switch to another mode
 through a reset map ``x+ = R(x-, z-, p, u, t)``. Modes may have different state vectors.
-This module only describes the model; :mod:`clutchocp.simulation.compiled` turns it into
+This module describes the model; :mod:`clutchocp.simulation.compiled` turns it into
 CasADi functions and :func:`clutchocp.simulation.simulate` integrates it.
 """
 
@@ -20,6 +20,8 @@ import casadi as ca
 import numpy as np
 
 from clutchocp.errors import ModelError
+from clutchocp.simulation.compiled import compile_model
+from clutchocp.simulation.derivative import time_derivative
 
 DIRECTIONS = {-1: "falling (+ to -)", 0: "either way", 1: "rising (- to +)"}
 
@@ -177,51 +179,6 @@ class Mode:
                 f"events={[e.name for e in self.events]})")
 
 
-def time_derivative(expr, x, ode, *, z=None, alg=None, t=None):
-    """Total time derivative of an expression along a DAE flow (e.g. jerk from an acceleration).
-
-    ``d expr/dt = e_x x' + e_z z' + e_t`` with ``x' = ode`` and ``z'`` from differentiating
-    ``0 = alg``: ``z' = -alg_z^-1 (alg_x x' + alg_t)`` (index 1). Parameters and
-    piecewise-constant inputs have zero derivative inside a piece. Usable before the
-    :class:`Mode` is built (so the derivative can be one of its outputs); see also
-    :meth:`Mode.time_derivative`.
-
-    Parameters
-    ----------
-    expr : casadi.SX
-        Expression of ``x, z`` (and parameters, inputs, ``t``).
-    x : mapping of str to casadi.SX or sequence of casadi.SX
-        Differential states.
-    ode : mapping of str to casadi.SX or sequence of casadi.SX
-        Their derivatives (same keys / order as ``x``).
-    z, alg : as for x, ode, optional
-        Algebraic variables and residuals.
-    t : casadi.SX, optional
-        The time symbol, if anything depends on time explicitly.
-
-    Returns
-    -------
-    casadi.SX
-        The derivative, same shape as ``expr`` (unit of ``expr`` per second).
-    """
-    def column(items, keys=None):
-        if isinstance(items, Mapping):
-            items = [items[k] for k in keys] if keys is not None else list(items.values())
-        return ca.vertcat(*[ca.SX(e) for e in items])
-
-    expr = ca.SX(expr)
-    x_col = column(x)
-    dx = column(ode, list(x) if isinstance(x, Mapping) and isinstance(ode, Mapping) else None)
-    result = ca.jtimes(expr, x_col, dx)
-    if z:
-        z_col, g = column(z), column(alg)
-        rhs = ca.jtimes(g, x_col, dx) + (ca.jacobian(g, t) if t is not None else 0)
-        result += ca.jtimes(expr, z_col, -ca.solve(ca.jacobian(g, z_col), rhs))
-    if t is not None:
-        result += ca.jacobian(expr, t)
-    return result
-
-
 class PiecewiseConstant:
     """A piecewise-constant input schedule.
 
@@ -302,6 +259,5 @@ class HybridModel:
     def compiled(self):
         """The CasADi functions of every mode (built once, then cached)."""
         if self._compiled is None:
-            from clutchocp.simulation.compiled import compile_model
             self._compiled = compile_model(self)
         return self._compiled

@@ -4,6 +4,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from clutchocp.output import write_csv
+
 
 @dataclass
 class EventRecord:
@@ -132,7 +134,6 @@ class Table(dict):
 
     def to_csv(self, path):
         """Write the table as CSV (the header holds the names with their units); returns the path."""
-        from clutchocp.output import write_csv
         return write_csv(path, {k: [str(v) for v in col] if k == "mode" else col for k, col in self.items()})
 
     def __repr__(self):

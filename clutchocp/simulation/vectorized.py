@@ -84,13 +84,100 @@ def padded_size(n):
     return -(-n // quantum) * quantum
 
 
+class PiecewiseCubic:
+    """A one-dimensional table function (a CasADi cubic B-spline or linear interpolant) as the
+    cubic polynomial of each of its grid intervals, evaluated with numpy.
+
+    CasADi evaluates a B-spline sample by sample (de Boor, ~0.55 us a sample: 0.9 ms for the
+    1 620 samples of a locked phase, once per film and per function that calls it); a polynomial
+    per interval costs ~30 ns a sample. Each interval's cubic goes through the table function's
+    own values at four points of that interval (the interval's ends and thirds), so within the
+    grid it is the same piecewise cubic up to rounding (checked at build time at every
+    interval's quarter points; the grid must hold the spline's knots). Samples outside the grid
+    (or NaN) are evaluated by CasADi itself, whatever its extrapolation is. On a uniform grid a
+    sample's interval is found by division; at a grid point the two neighbouring cubics agree to
+    rounding.
+    """
+
+    # inverse of the Vandermonde matrix of u = 0, 1/3, 2/3, 1 (rows: coefficients of u^0..u^3)
+    _FIT = np.linalg.inv(np.vander(np.array([0.0, 1 / 3, 2 / 3, 1.0]), 4, increasing=True))
+
+    def __init__(self, function, grid, rtol=1e-12):
+        grid = np.asarray(grid, float)
+        if grid.ndim != 1 or grid.size < 2 or np.any(np.diff(grid) <= 0):
+            raise ValueError("a table's grid must be a strictly increasing 1-D array of two or more points")
+        self.function, self.grid = function, grid
+        step = (grid[-1] - grid[0]) / (grid.size - 1)
+        self._inverse_step = 1.0 / step if np.allclose(np.diff(grid), step, rtol=1e-12, atol=0) else None
+        u = np.array([0.0, 1 / 3, 2 / 3, 1.0])
+        points = grid[:-1, None] + u[None, :] * np.diff(grid)[:, None]
+        values = np.array(function(ca.DM(points.ravel()).T), dtype=float).reshape(points.shape)
+        self.coefficients = np.ascontiguousarray((values @ self._FIT.T).T)   # (4, intervals): c0 + c1 u + ... c3 u^3
+        check = grid[:-1, None] + np.array([0.25, 0.5, 0.75])[None, :] * np.diff(grid)[:, None]
+        exact = np.array(function(ca.DM(check.ravel()).T), dtype=float).ravel()
+        scale = max(1.0, float(np.max(np.abs(values))))
+        if not np.max(np.abs(self(check.ravel()) - exact)) <= rtol * scale:
+            raise ValueError(f"table function {function.name()} is not a cubic on each interval of the grid given")
+
+    def __call__(self, x):
+        """Values at the samples ``x`` (1-D array)."""
+        x = np.asarray(x, float)
+        grid = self.grid
+        if self._inverse_step is not None:      # uniform grid: the interval by division (no search)
+            i = np.nan_to_num((x - grid[0]) * self._inverse_step, nan=0.0, posinf=0.0, neginf=0.0).astype(np.intp)
+        else:
+            i = np.searchsorted(grid, x, side="right") - 1
+        np.clip(i, 0, grid.size - 2, out=i)
+        u = (x - grid[i]) / (grid[i + 1] - grid[i])
+        c0, c1, c2, c3 = (row[i] for row in self.coefficients)
+        y = c0 + u * (c1 + u * (c2 + u * c3))
+        outside = ~((x >= grid[0]) & (x <= grid[-1]))
+        if outside.any():
+            y[outside] = _casadi_call(self.function, x[outside])
+        return y
+
+
+_TABLES = {}            # hash of a CasADi table function -> its PiecewiseCubic
+
+
+def register_table(function, grid):
+    """Evaluate the 1-D table ``function`` (a CasADi interpolant whose knots are all on ``grid``)
+    with numpy wherever a numpy-translated function calls it (:class:`PiecewiseCubic`); a table
+    that is not a cubic on each interval of ``grid`` is left to CasADi (ValueError)."""
+    _TABLES[hash(function)] = PiecewiseCubic(function, grid)
+
+
+def calls_unregistered(function):
+    """Whether the SX ``function`` calls a function that is not a registered table (a call that
+    the numpy form pays per sample, through CasADi)."""
+    if not function.is_a("SXFunction"):
+        return False
+    calls = [k for k in range(function.n_instructions()) if function.instruction_id(k) == ca.OP_CALL]
+    if not calls:
+        return False
+    instructions = function.instructions_sx()
+    return any(hash(instructions[k].which_function()) not in _TABLES for k in calls)
+
+
 def _call(callee, *args):
-    """``callee`` (scalar in, scalar out, e.g. an interpolant or its derivative) on every sample,
-    through a map over the samples called with the buffer interface (numpy in and out)."""
+    """``callee`` (scalar in, scalar out, e.g. an interpolant or its derivative) on every sample:
+    a registered table (:func:`register_table`) with numpy, anything else through a map over the
+    samples called with the buffer interface (numpy in and out)."""
     shape = np.broadcast(*args).shape
     n = int(np.prod(shape)) if shape else 1
     if n == 0:
         return np.zeros(shape)
+    table = _TABLES.get(hash(callee))
+    if table is not None and len(args) == 1:
+        result = table(np.ravel(np.broadcast_to(args[0], shape)))
+    else:
+        result = _casadi_call(callee, *(np.ravel(np.broadcast_to(a, shape)) for a in args))
+    return result.reshape(shape) if shape else float(result[0])
+
+
+def _casadi_call(callee, *args):
+    """``callee`` on the ``n`` samples of the flat arrays ``args`` through a cached map: (n,) array."""
+    n = args[0].size
     m = padded_size(n)
     key = (callee.name(), m)
     entry = _MAPS.get(key)
@@ -100,13 +187,13 @@ def _call(callee, *args):
         mapped = callee.map(m)
         entry = _MAPS[key] = (callee, mapped, *mapped.buffer())
     _, _, buffer, evaluate = entry
-    values = iter([_pad(np.broadcast_to(a, shape), n, m) for a in args])
+    values = iter([_pad(a, n, m) for a in args])
     for i in range(callee.n_in()):
         buffer.set_arg(i, memoryview(next(values) if callee.nnz_in(i) else _DUMMY))
     result = np.empty(m)
     buffer.set_res(0, memoryview(result))
     evaluate()
-    return result[:n].reshape(shape) if shape else float(result[0])
+    return result[:n]
 
 
 def _pad(a, n, m):

@@ -9,7 +9,7 @@ from matplotlib.figure import Figure
 
 from ..output import save_figure
 from ..scene.schema import PARTS
-from .folder import CALIBRATION, _read_complete
+from .folder import CALIBRATION, read_complete
 
 # The results drawn per task (at most four: a 2 x 2 panel figure).
 PLOTTED = {
@@ -188,7 +188,7 @@ def _curves(out, scene, task, rows, fields):
         return None
     with path.open(encoding="utf-8") as fh:
         header = fh.readline().strip().split(",")
-    table = _read_complete(path, header)
+    table = read_complete(path, header)
     if not table:
         return None
     by_point = {}

@@ -150,14 +150,14 @@ class StudyFolder:
         Also drops calibration rows of points that have no results row (written just before
         an interruption).
         """
-        rows = _read_complete(self.path / RESULTS, self.columns)
+        rows = read_complete(self.path / RESULTS, self.columns)
         done = {row["point_id"] for row in rows}
         calibration = self.path / CALIBRATION
         if calibration.is_file():
             with calibration.open(newline="", encoding="utf-8") as fh:
                 header = next(csv.reader(fh), None)
             if header:
-                kept = [r for r in _read_complete(calibration, header) if r["point_id"] in done]
+                kept = [r for r in read_complete(calibration, header) if r["point_id"] in done]
                 _rewrite(calibration, header, kept)
         return rows
 
@@ -194,7 +194,7 @@ def _open_append(path, header):
     return fh
 
 
-def _read_complete(path, columns):
+def read_complete(path, columns):
     """Parsed rows of a CSV written by this module; a last line without its newline is cut off."""
     if not path.is_file():
         return []

@@ -5,13 +5,13 @@ An ordinary optimize point builds its :class:`~clutchocp.optimal.problem.Engagem
 engagement model with the point's values as numbers, the scaled NLP, its exact derivatives and
 IPOPT solvers, and the same again for the polish stage on the exact switching laws. Here a worker
 builds that once (:class:`SweepOCP`, at its first point) with the swept fields as a parameter
-vector theta of the NLP functions (the engagement model of a
-:class:`~clutchocp.scene.symbolic.SymbolicScene`, as the robust problem does), and at every further
+vector theta of the NLP functions (a :class:`~clutchocp.optimal.parametric.ParametricOCP`, the
+problem the robust scenarios use too), and at every further
 point only sets the point's values (:meth:`SweepOCP.set_point`) and solves again, starting from the
 neighbour's optimum.
 
 Scales. The ordinary problem scales time, energy, jerk and lock-up torque by references from the
-point's own baseline run (``EngagementOCP._scales``: t_ref, E_ref, J_ref, T_ref). The reused problem
+point's own baseline run (``EngagementOCP._references``: t_ref, E_ref, J_ref, T_ref). The reused problem
 keeps the first point's references (index 0) for its variables -- a change of variables, the same
 physical problem -- and moves the point's references into the objective weights, so that its
 objective is the ordinary one term by term (problem.py module notes, J):
@@ -38,15 +38,15 @@ bound on either problem).
 import copy
 import time
 
-import casadi as ca
 import numpy as np
 
 from ..engagement.model import EngagementModel
-from ..engagement.run import simulate_engagement
+from ..engagement.run import EngagementResult, simulate_engagement, summarize
 from ..optimal.bound import output_jerk_share
 from ..optimal.heat import heat_limits
-from ..engagement.run import EngagementResult, summarize
-from ..optimal.problem import OBJECTIVE_TERMS, SLIP_MODE, EngagementOCP
+from ..optimal.models import SceneModels, quasi_static_scene
+from ..optimal.objective import OBJECTIVE_TERMS
+from ..optimal.parametric import ParametricOCP
 from ..optimal.replay import CommandModel
 from ..scene.symbolic import SymbolicScene
 from ..simulation import HybridModel, SimulationOptions, simulate
@@ -62,8 +62,9 @@ def field_values(scene, names):
     return np.array([float(scene.value(name)) for name in names])
 
 
-class SweepOCP(EngagementOCP):
-    """An :class:`EngagementOCP` of ``scene`` with the fields ``names`` as NLP parameters.
+class SweepOCP(ParametricOCP):
+    """A :class:`~clutchocp.optimal.parametric.ParametricOCP` of ``scene`` with the swept fields
+    ``names`` as NLP parameters, set to one point of the sweep after another.
 
     Parameters
     ----------
@@ -83,48 +84,16 @@ class SweepOCP(EngagementOCP):
     """
 
     def __init__(self, scene, names, **options):
-        self.parameter_names = tuple(names)
-        self.theta = ca.SX.sym("theta", len(self.parameter_names))
-        self.theta_value = field_values(scene, self.parameter_names)
-        super().__init__(scene, **options)
+        super().__init__(scene, names, **options)
         if len(self.phase_modes) != 1 or not self.holds_torque:
             raise NotReusable("a fill phase or a lock that carries no torque")
         self.point_scales = self.scales
         self._structure = self.structure(self.model)
 
-    def _ocp_scene(self, scene):
-        # as EngagementOCP.__init__: plate masses taken as massless
-        return scene.with_overrides({"pack.model": "massless", "pack.plate_masses": None}) \
-            if self.quasi_static_plates else scene
-
-    def _build_functions(self, mode_name=SLIP_MODE, role="slip"):
-        numeric = self.model
-        symbols = dict(zip(self.parameter_names, ca.vertsplit(self.theta)))
-        try:
-            self.model = EngagementModel(SymbolicScene(self._ocp_scene(self.scene), symbols), smooth=self.smooth,
-                                         pressure_command=self.u)
-            out = super()._build_functions(mode_name, role)
-        finally:
-            self.model = numeric
-        jump = out["jump_fn"]
-        out["jump_fn"] = lambda x, u: jump(x, u, self.theta_value)
-        return out
-
-    def _evaluate(self, xs, us, fns=None):
-        fns = fns or self.phase_functions["slip"]
-        n = len(us)
-        values = np.array(fns["outputs_fn"].map(n)(np.asarray(xs).T, np.asarray(us)[None, :],
-                                                   np.repeat(self.theta_value[:, None], n, axis=1)))
-        return {name: values[i] for i, name in enumerate(fns["output_names"])}
-
     def structure(self, model):
         """What the reused problem takes from its first point besides the swept values, for ``model``
         (the numeric model of a point): a point is reusable if this is the first point's."""
-        numeric, self.model = self.model, model
-        try:
-            groups = self._state_groups()
-        finally:
-            self.model = numeric
+        groups = self._state_groups(model)
         phys = [model.index[n] for n in groups]
         scene = model.scene
         return (model.initial_mode(), tuple(model.state_names), tuple(map(tuple, groups.values())),
@@ -135,32 +104,32 @@ class SweepOCP(EngagementOCP):
                 tuple(heat_limits(model, self.options["max_temperature_C"],
                                   self.options["max_specific_power_W_mm2"])))
 
-    def set_point(self, scene, baseline=None, point_scales=None):
+    def set_point(self, scene, baseline=None, point_scales=None, models=None):
         """Make this the problem of ``scene`` (a point of the sweep): its values, baseline run and
         references; raises :class:`NotReusable` where it differs in more (the module notes).
 
-        ``baseline`` and ``point_scales`` are given by the smooth problem to its polish twin (which
-        then takes the smooth model's references, as the ordinary twin takes the baseline)."""
+        ``baseline``, ``point_scales`` and ``models`` are given by the smooth problem to its polish twin
+        (which then takes the smooth model's references, as the ordinary twin takes the baseline)."""
         if point_scales is None:
-            model = EngagementModel(self._ocp_scene(scene), smooth=self.smooth, pressure_command=self.u)
+            model = EngagementModel(quasi_static_scene(scene) if self.quasi_static_plates else scene,
+                                    smooth=self.smooth, pressure_command=self.u)
             if self.structure(model) != self._structure:
                 raise NotReusable("the point changes more than the swept values")
         if baseline is None:
             baseline = self.baseline_run(scene)
         self.scene, self.baseline, self._fastest = scene, baseline, None
+        self.models = SceneModels(scene) if models is None else models
         self.reference_run = baseline if baseline.summary["engagement_time_s"] is not None else self.fastest_run()
         self.output_jerk_share = 1.0 if self.output_held else output_jerk_share(scene)
         if point_scales is None:
-            self.model, template = model, self.scales
-            point_scales = self._scales()            # the point's references (the ordinary build's scales)
-            self.scales = template
-            holds, self.holds_torque = self.holds_torque, True      # the reused problem's, as built
+            self.model = model
+            point_scales, holds = self._references(model)   # the point's references (the ordinary build's scales)
             if not holds:
                 raise NotReusable("the lock carries no torque at this point")
         self.point_scales = point_scales
         self.theta_value = field_values(scene, self.parameter_names)
         if self._exact is not None:
-            self._exact.set_point(scene, baseline, point_scales)
+            self._exact.set_point(scene, baseline, point_scales, self.models)
 
     def baseline_run(self, scene):
         """The IDAS run of the point's own profile (the ordinary build's baseline): on one model with
@@ -214,20 +183,9 @@ class SweepOCP(EngagementOCP):
         w["smooth"] *= pt.time_s / sc.time_s
         return [w[k] for k in OBJECTIVE_TERMS] + list(self.theta_value)
 
-    def check_feasible_time(self, t_max):
-        template, self.scales = self.scales, self.point_scales       # the point's own lock time
-        try:
-            super().check_feasible_time(t_max)
-        finally:
-            self.scales = template
-
-    @property
-    def exact(self):
-        """The reused twin on the exact forms (the polish stage), at the same point."""
-        if self._exact is None:
-            self._exact = SweepOCP(self.scene, self.parameter_names, smooth=False, polish=False,
-                                   baseline=self.baseline, transcription=self.transcription, **self.options)
-        return self._exact
+    def check_feasible_time(self, t_max, t_ref=None):
+        """As the ordinary problem's, against the point's own lock time."""
+        super().check_feasible_time(t_max, self.point_scales.time_s if t_ref is None else t_ref)
 
 
 class StepRuns:

@@ -8,6 +8,7 @@ import numpy as np
 from ..errors import ModelError
 from ..output import write_summary
 from ..scene import load_scene
+from ..scene.uncertainty import Uncertainty
 from ..simulation.native import native_status
 from .executor import StudyInterrupted, check_engine, default_workers, execute, frozen_heap
 from .figures import draw_study
@@ -46,8 +47,6 @@ def study_points(scene, grid=(), samples=None, seed=0, uncertain=()):
     if samples is not None:
         if not (isinstance(samples, int) and samples >= 1):
             raise StudySpecError(f"--samples {samples!r}: must be a whole number >= 1")
-        from ..uncertainty import Uncertainty
-
         u = Uncertainty.from_scene(scene, extra=tuple(uncertain))
         if not u.names:
             raise StudySpecError("--samples: the scene declares no [uncertainty] and no --uncertain was given")

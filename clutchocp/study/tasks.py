@@ -11,11 +11,20 @@ that fails gives ``status = "failed"`` and the one-line reason, and the unit goe
 """
 
 import functools
+import multiprocessing
 import threading
 import time
 from dataclasses import asdict, dataclass, field
 
+from ..engagement.model import EngagementModel
+from ..engagement.run import simulate_engagement
 from ..errors import ClutchocpError, ModelError, SolverError
+from ..interrupt import ignore_sigint, sigint_held
+from ..optimal.problem import EngagementOCP
+from ..optimal.verify import verify
+from ..scene import load_scene
+from ..simulation.native import compiler
+from . import parametric, parametric_ocp
 from .points import point_id
 
 TASKS = ("simulate", "optimize")
@@ -92,7 +101,6 @@ class Task:
 
 @functools.lru_cache(maxsize=8)
 def _base_scene(scene, overrides_items):
-    from ..scene import load_scene
     return load_scene(scene, overrides=dict(overrides_items) or None)
 
 
@@ -168,10 +176,6 @@ def _run_settings(task):
 
 def simulate_point(task, point):
     """Simulate one point; returns ``(row, None)``."""
-    from ..engagement.model import EngagementModel
-    from ..engagement.run import simulate_engagement
-    from ..simulation.native import compiler
-
     opts = task.options
     has_compiler = compiler() is not None                       # no compiler: the VM, silently
     settings = _run_settings(task)
@@ -210,17 +214,12 @@ def _parametric_key(task, point):
 def _reference_numbers(task, point, settings):
     """What the usual run of ``point`` (a model of its own, CasADi's virtual machine) gives for the
     numbers a parametric run is checked against (:func:`clutchocp.study.parametric.agrees`)."""
-    from ..engagement.run import simulate_engagement
-    from . import parametric
-
     summary = simulate_engagement(point_scene(task, point), **dict(settings, native=False)).summary
     return {key: summary[key] for key in (*parametric.COMPARED, "final_mode")}
 
 
 def _send_reference(connection, task, point, settings):
     """Body of the process that runs the usual run beside the warm-up."""
-    from ..interrupt import ignore_sigint
-
     ignore_sigint()                          # Ctrl-C is the parent's, which stops this process
     try:
         connection.send(("ok", _reference_numbers(task, point, settings)))
@@ -238,10 +237,6 @@ def _reference_beside(task, point):
     share the cores instead of following each other (the other core is idle while the sweep's
     first point runs). Started only where the point will be checked (a reused model not yet built
     in this process) and where processes are forked."""
-    import multiprocessing
-
-    from ..interrupt import sigint_held
-
     if not (task.options["reuse_model"] and all(isinstance(v, float) for v in point.values())) \
             or _parametric_key(task, point) in _PARAMETRIC or "fork" not in multiprocessing.get_all_start_methods():
         return
@@ -284,9 +279,6 @@ def _simulate_reusing(task, point, scene, settings):
     """The run of ``point`` on this worker's parametric model, or None where it cannot be used
     (a choice field, a field the model cannot take as a symbol, a run that fails: the usual run
     then gives the result or the failure and its reason)."""
-    from ..engagement.run import simulate_engagement
-    from . import parametric
-
     names = tuple(sorted(point))
     if not all(isinstance(point[n], float) for n in names):
         return None
@@ -336,9 +328,6 @@ def _problem(task, point, scene):
     """The problem of ``point``: this worker's reused problem set to the point, or a new one.
 
     Returns ``(ocp, reused)``."""
-    from ..optimal.problem import EngagementOCP
-    from . import parametric_ocp
-
     opts = task.options
     settings = {"intervals": opts["intervals"], "degree": opts["degree"]}
     names = tuple(sorted(point))
@@ -360,8 +349,6 @@ def _problem(task, point, scene):
 
 def optimize_point(task, point, guess=None):
     """Solve one point; returns ``(row, curve, optimum)`` (``curve`` and ``optimum`` None on failure)."""
-    from ..optimal.verify import verify
-
     opts = task.options
     start = time.perf_counter()
     try:

@@ -1,0 +1,230 @@
+"""Benchmark machinery (clutchocp.bench): matched-error interpolation, growth exponents, error
+measures against a confirmed reference, CVODES on the engine, and one small end-to-end run of
+run_bench (the full and --quick runs are benchmarks, not tests)."""
+
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+from clutchocp.bench import floor, optimization, scaling
+from clutchocp.bench import run as bench_run
+from clutchocp.bench import workprecision as wp
+from clutchocp.bench.progress import Progress
+from clutchocp.engagement.model import EngagementModel
+from clutchocp.engagement.run import simulate_engagement
+from clutchocp.errors import ModelError, SolverError
+from clutchocp.scene.loader import load_scene
+
+
+def test_time_at_error_interpolates_a_power_law_exactly():
+    # time = 2 error^-0.25: log-log linear, so interpolation between any two points is exact
+    points = [(e, 2 * e**-0.25) for e in (1e-3, 1e-5, 1e-7)]
+    assert wp.time_at_error(points, 1e-6) == pytest.approx(2 * 1e-6**-0.25, rel=1e-12)
+    assert wp.time_at_error(points, 1e-8) is None and wp.time_at_error(points, 1e-2) is None
+
+
+def test_time_at_error_uses_the_pareto_front():
+    # (1e-4, 5.0) is beaten by (1e-5, 2.0): more accurate and cheaper, so it is not on the front;
+    # a run without a finite error is left out
+    points = [(1e-3, 1.0), (1e-4, 5.0), (1e-5, 2.0), (math.inf, 0.1)]
+    assert wp.pareto_front(points) == [(1e-5, 2.0), (1e-3, 1.0)]
+    assert wp.time_at_error(points, 1e-4) == pytest.approx(math.sqrt(2.0), rel=1e-12)   # log-midpoint of 2 and 1
+
+
+def test_a_loose_run_slower_than_a_tight_one_leaves_the_levels_between_them_reached():
+    # a two-tolerance sweep whose loose run was timed slower than its tight one (a busy machine):
+    # the tight run is the cheapest at least as accurate at every level up to the loose run's error
+    points = [(1e-8, 2.0), (1e-5, 3.0)]
+    assert wp.pareto_front(points) == [(1e-8, 2.0)]
+    assert wp.time_at_error(points, 1e-6) == 2.0 and wp.time_at_error(points, 1e-5) == 2.0
+    assert wp.time_at_error(points, 1e-9) is None and wp.time_at_error(points, 1e-4) is None
+    rows = [{"method": m, "status": "ok", "error": e, "wall_time_s": w}
+            for m, pts in (("idas", [(1e-8, 1.0), (1e-5, 0.5)]), ("Radau", points)) for e, w in pts]
+    ratios = wp.speedups(rows, peers=("Radau",), levels=(1e-6,))["Radau"]
+    assert ratios[1e-6] == pytest.approx(2.0 / 0.5 ** (2 / 3))          # idas: 2/3 of the way in log-log
+
+
+def test_speedups_divide_peer_time_by_idas_time_at_each_level():
+    rows = [{"method": m, "status": "ok", "error": e, "wall_time_s": f * e**-0.2}
+            for m, f in (("idas", 1.0), ("Radau", 7.0)) for e in (1e-4, 1e-6, 1e-8)]
+    ratios = wp.speedups(rows, peers=("Radau",), levels=(1e-5, 1e-7, 1e-9))
+    assert ratios["Radau"][1e-5] == pytest.approx(7.0) and ratios["Radau"][1e-7] == pytest.approx(7.0)
+    assert ratios["Radau"][1e-9] is None
+    assert wp.headline(ratios["Radau"]) == (pytest.approx(7.0), pytest.approx(7.0), 2)
+
+
+def test_whole_over_floor_divides_the_whole_run_speedup_by_the_floor():
+    entry = {"speedup_vs_radau": 3.0, "floor_speedup_vs_radau": 6.0, "speedup_vs_lsoda": 2.0,
+             "floor_speedup_vs_lsoda": None}
+    assert bench_run.whole_over_floor(entry) == {"whole_over_floor_vs_radau": 0.5, "whole_over_floor_vs_lsoda": None}
+
+
+def test_growth_exponent_of_a_power_law():
+    n = np.array([1, 2, 4, 8, 16])
+    assert scaling.growth_exponent(n, 3e-3 * n**1.25) == pytest.approx(1.25, rel=1e-12)
+
+
+def test_with_pairs_repeats_the_plate_mass():
+    scene = scaling.with_pairs(load_scene("bao2020"), 4)
+    assert scene.value("plates.n_interfaces") == 4
+    assert list(scene.value("pack.plate_masses")) == [pytest.approx(0.367)] * 4
+    assert scaling.with_pairs(load_scene("zhang2021"), 3).value("plates.n_interfaces") == 3
+
+
+@pytest.fixture(scope="module")
+def zhang():
+    scene = load_scene("zhang2021")
+    model = EngagementModel(scene)
+    reference, confirmation = wp.reference_runs(scene, model)
+    return scene, model, reference, confirmation
+
+
+def test_reference_is_confirmed_by_a_second_method(zhang):
+    """IDAS at rtol 1e-12 against scipy Radau at 1e-10 on the same equations: measured 3e-11."""
+    _, _, _, confirmation = zhang
+    assert confirmation["method"] == "Radau"
+    assert confirmation["errors"]["max"] <= 1e-9
+
+
+def test_error_measures_vanish_on_the_reference_and_shrink_with_the_tolerance(zhang):
+    scene, model, reference, _ = zhang
+    assert wp.trajectory_errors(reference, reference)["max"] == 0.0
+    loose = wp.trajectory_errors(wp.run_method(scene, model, "idas", 1e-5), reference)
+    tight = wp.trajectory_errors(wp.run_method(scene, model, "idas", 1e-8), reference)
+    assert set(loose) == {"speeds", "gaps", "lock_time", "torque_jump", "max"}
+    assert loose["max"] == max(loose[k] for k in wp.ERROR_PARTS)
+    assert 0 < tight["max"] < loose["max"] / 30        # three decades of tolerance, > 1.5 decades of error
+
+
+def test_a_run_that_never_locks_has_infinite_lock_time_error(zhang):
+    scene, model, reference, _ = zhang
+    short = simulate_engagement(scene, model=model, rtol=1e-8, atol=1e-10)
+    short.summary = dict(short.summary, engagement_time_s=None, lockup_torque_jump_Nm=None)
+    errors = wp.trajectory_errors(short, reference)
+    assert errors["lock_time"] == math.inf and errors["max"] == math.inf
+
+
+def test_engine_event_tolerances_follow_the_integration_tolerance():
+    assert wp.event_options(1e-4) == {"event_value_tol": 1e-6, "event_time_tol": 1e-9}
+    assert wp.event_options(1e-10) == {"event_value_tol": 1e-10, "event_time_tol": pytest.approx(1e-13)}
+
+
+def test_cvodes_integrates_the_same_equations_as_idas(zhang):
+    """CVODES (BDF, ODE) through the same hybrid engine: lock time within 1e-7 of the reference
+    at rtol 1e-9 (measured 6e-10), with its step counts reported."""
+    scene, model, reference, _ = zhang
+    run = wp.run_method(scene, model, "cvodes", 1e-9)
+    assert run.summary["solver"]["method"] == "cvodes"
+    assert run.summary["solver"]["statistics"]["n_steps"] > 0
+    assert wp.trajectory_errors(run, reference)["lock_time"] <= 1e-7
+
+
+def test_cvodes_refuses_a_mode_with_algebraic_variables():
+    """A compliant output shaft makes the clutch hub speed an algebraic variable: CVODES cannot
+    integrate that DAE, and says so."""
+    scene = load_scene("default_driveline").with_overrides({"driveline.shaft_stiffness": "5e3 N m",
+                                                           "driveline.shaft_damping": "5 N m s"})
+    with pytest.raises(ModelError, match="cvodes.*algebraic"):
+        simulate_engagement(scene, method="cvodes")
+
+
+def test_wall_time_cap_stops_every_method_with_a_clear_message():
+    scene = load_scene("bao2020")
+    model = EngagementModel(scene)
+    for method in ("idas", "cvodes", "Radau"):
+        with pytest.raises(SolverError, match="wall-time limit") as info:
+            simulate_engagement(scene, model=model, method=method, solver_options={"max_wall_time": 1e-4})
+        assert "Try:" in str(info.value)
+
+
+def test_progress_goes_to_the_given_stream(capsys):
+    import io
+
+    stream = io.StringIO()
+    bar = Progress(4, stream=stream)
+    bar.step("first")
+    bar.note("aside")
+    bar.close()
+    text = stream.getvalue()
+    lines = text.replace("\r", "\n").splitlines()
+    assert "1/4" in text                                                   # the count of steps done
+    assert [line.split()[-1] for line in lines if "first" in line or "aside" in line] == ["first", "aside"]
+    assert all(line.split()[0].count(":") == 1 for line in lines if "first" in line)      # elapsed mm:ss
+    assert capsys.readouterr().err == ""                                   # nothing beside the stream
+    Progress(2, enabled=False).step("silent")
+    assert capsys.readouterr().err == ""
+
+
+def test_floor_pieces_run_from_switch_to_switch(zhang):
+    """zhang2021 slips, then locks: two pieces, the first from t = 0 to the lock-up event, the
+    second from the state after the lock-up (locked mode) to the end."""
+    scene, model, reference, _ = zhang
+    parts = floor.pieces(reference)
+    lock = reference.result.events[-1]
+    assert [p[0].name for p in parts] == [lock.source, lock.target]
+    assert parts[0][1] == 0.0 and parts[0][4] == pytest.approx(lock.t, abs=0)
+    assert parts[1][1] == lock.t and parts[1][4] == scene.value("simulation.t_end")
+    cm = parts[1][0]
+    after = np.array([lock.x_after[n] for n in cm.x_names]) / cm.x_nominal
+    assert np.array_equal(parts[1][2], after)
+
+
+def test_floor_pieces_reproduce_the_reference_with_both_integrators(zhang):
+    """Each piece integrated alone from the reference state at its start, by IDAS and by scipy
+    Radau (independent integrators), ends on the reference state; the error shrinks with rtol."""
+    _, model, reference, _ = zhang
+    parts = floor.pieces(reference)
+    errors = {}
+    for method in ("idas", "Radau"):
+        for rtol in (1e-5, 1e-9):
+            time_s, errors[method, rtol] = floor.floor_run(model, parts, method, rtol, repeats=1)
+            assert time_s > 0
+        assert errors[method, 1e-9] < errors[method, 1e-5]
+        assert errors[method, 1e-9] <= 1e-7
+
+
+def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
+    """A reduced run (one scene, two tolerances, two methods, two pack sizes, no optimisation)
+    through the real run_bench: every file and the summary keys the lead's CLI reports."""
+    monkeypatch.setitem(bench_run.QUICK, "tolerances", (1e-5, 1e-8))
+    monkeypatch.setitem(bench_run.QUICK, "methods", ("idas", "cvodes", "Radau", "BDF", "LSODA"))
+    monkeypatch.setattr(scaling, "PAIRS", (1, 2))
+    monkeypatch.setattr(optimization, "plan", lambda quick: None)
+    summary = bench_run.run_bench(tmp_path, quick=True, progress=False, scenes=[load_scene("zhang2021")])
+    names = {p.name for p in tmp_path.iterdir()}
+    assert {"summary.json", "engagement_work_precision.csv", "engagement_work_precision.png",
+            "engagement_speedup.csv", "engagement_integrator_floor.csv", "scaling.csv", "scaling.png", "stiffness_zhang2021.png",
+            "stiffness_zhang2021.csv"} <= names
+    written = json.loads((tmp_path / "summary.json").read_text())
+    entry = written["scenes"]["zhang2021"]
+    for key in ("speedup_vs_radau", "speedup_vs_bdf", "speedup_vs_lsoda", "speedup_vs_cvodes",
+                "scaling_exponent_pairs", "stiffness"):
+        assert key in entry
+    assert entry["scaling"]["pairs"] == [1, 2]
+    assert written["optimization"]["available"] is False
+    assert "targets" not in summary and "engagement_targets" not in summary     # no fixed targets
+    assert all(s["time_ratio"] < 1.0 and s["scene"] == "zhang2021" for s in written["idas_slower"])
+    for key in ("speedup_vs_radau_integration", "speedup_vs_lsoda_integration"):
+        assert entry[key] is not None and entry[key] > 0
+    rows = [r for r in csv.DictReader(open(tmp_path / "engagement_work_precision.csv")) if r["status"] == "ok"]
+    for row in rows:     # the integrator calls are part of the run, so they take less time than it
+        assert 0 < float(row["integration_time_s"]) < float(row["wall_time_s"])
+    whole = {(r["method"], r["rtol"]): r for r in rows}
+    low = [r for r in csv.DictReader(open(tmp_path / "engagement_integrator_floor.csv")) if r["status"] == "ok"]
+    assert {r["method"] for r in low} == {"idas", "Radau", "LSODA"}
+    for row in low:      # a floor point keeps the error of the whole run at its tolerance
+        assert float(row["time_s"]) > 0
+        assert row["error"] == whole[row["method"], row["rtol"]]["error"]
+    for method in ("idas", "Radau", "LSODA"):       # and its pieces end nearer the reference at 1e-8
+        end = {float(r["rtol"]): float(r["piece_end_error"]) for r in low if r["method"] == method}
+        assert end[1e-8] < end[1e-5], method
+    for key in ("floor_speedup_vs_radau", "floor_speedup_vs_lsoda"):
+        assert entry[key] is not None and entry[key] > 0
+    assert written["scenes"]["zhang2021"].keys() >= {"whole_over_floor_vs_radau", "whole_over_floor_vs_lsoda"}
+    assert entry["whole_over_floor_vs_radau"] == bench_run.whole_over_floor(entry)["whole_over_floor_vs_radau"]
+    assert written["single_run_s"] == {}          # bao2020 not among the scenes: not timed
+    text = bench_run.format_summary(summary)
+    assert "issue" not in text and "target" not in text and "integrator floor" in text

@@ -99,6 +99,7 @@ class FilmLaw:
         self.temperature_C = temperature if temperature is not None else scene.get("friction.temperature_C")
         self.rho = scene.value("oil.density")
         self.land_fraction = scene.value("plates.land_fraction")
+        self.shear_factors = scene.get("film.shear_factors", "table")
         self.permeability = scene.value("plates.lining_permeability")
         self.lining_thickness = scene.value("plates.lining_thickness")
         self.flow_factor = scene.get("film.flow_factor", "patir_cheng")
@@ -252,7 +253,8 @@ class FilmLaw:
         """
         return shear.viscous_torque(w_rel, h, self.eta, self.r1, self.r2, sigma_1=self.sigma_1,
                                     sigma_2=self.sigma_2, area_ratio=self.area_ratio(h),
-                                    land_fraction=self.land_fraction, smooth=self.smooth, smooth_cutoff=True)
+                                    land_fraction=self.land_fraction, smooth=self.smooth, smooth_cutoff=True,
+                                    method=self.shear_factors)
 
     def contact_torque(self, h, w_rel, direction):
         """Asperity friction torque [N m] while slipping in ``direction`` (+1 or -1) (Bao Eq. 25)."""

@@ -70,6 +70,7 @@ class HvdFilm:
                                  "give one of them or make them agree")
             land = groove_land
         self.land_fraction = land
+        self.shear_factors = scene.get("film.shear_factors", "table")
         self.land_area = land * self.area                                # Cui Eq. 16
         self.r_eff = contact.effective_radius(self.r1, self.r2, rule="cui")  # Cui Eq. 19
         self.has_roughness = scene.has("roughness") and scene.value("roughness.sigma") > 0
@@ -172,7 +173,8 @@ class HvdFilm:
         """Shear torque on the lands (Cui Eq. 9) plus over the grooves (Liao Eq. 2) [N m]."""
         land = shear.viscous_torque(w_rel, h, self.eta, self.r1, self.r2, sigma_1=self.sigma_1,
                                     sigma_2=self.sigma_2, area_ratio=self.area_ratio(h),
-                                    land_fraction=self.land_fraction, smooth=self.smooth)   # Cui Eq. 9
+                                    land_fraction=self.land_fraction, smooth=self.smooth,
+                                    method=self.shear_factors)                            # Cui Eq. 9
         if not self.grooved:
             return land
         groove_share = 1.0 - self.land_fraction                                # theta1 / (theta1 + theta2)

@@ -77,3 +77,53 @@ def softplus(x, width):
 def smooth_step(x, width):
     """Smooth Heaviside step: 0.5 (1 + tanh(x / width)); equals 0.5 at x = 0."""
     return 0.5 * (1 + tanh(x / width))
+
+
+def apply_elementwise(function, x):
+    """Evaluate a scalar-in, scalar-out CasADi Function (e.g. an interpolant) elementwise.
+
+    Parameters
+    ----------
+    function : casadi.Function
+        One scalar input, one scalar output.
+    x : float, array or CasADi SX/MX/DM
+        Argument.
+
+    Returns
+    -------
+    Same shape as x: a CasADi matrix for CasADi input, else a numpy array (0-d for a float).
+    """
+    if is_symbolic(x):
+        if x.is_scalar():
+            return function(x)
+        n = x.numel()
+        row = function.map(n)(ca.reshape(x, 1, n))
+        return ca.reshape(row, x.size1(), x.size2())
+    arr = np.asarray(x, dtype=float)
+    if arr.size == 0:
+        return np.empty(arr.shape)
+    return np.array(function(arr.reshape(1, -1)), dtype=float).reshape(arr.shape)
+
+
+_DECLARED_TABLES = []   # (function, grid) of 1-D tables the engine may evaluate with numpy
+
+
+def declare_table(function, grid):
+    """Declare a 1-D table: a scalar CasADi interpolant whose knots all lie on ``grid``.
+
+    A numpy-translated model (``clutchocp.simulation.vectorized``) then evaluates its calls with
+    numpy instead of CasADi, per sample. Declaring changes no result.
+
+    Parameters
+    ----------
+    function : casadi.Function
+        One scalar input, one scalar output, a cubic on each interval of ``grid``.
+    grid : array of float
+        Strictly increasing knots of the table.
+    """
+    _DECLARED_TABLES.append((function, np.asarray(grid, dtype=float)))
+
+
+def declared_tables():
+    """The tables declared so far, as (function, grid) pairs, oldest first."""
+    return tuple(_DECLARED_TABLES)

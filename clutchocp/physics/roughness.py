@@ -14,9 +14,8 @@ import casadi as ca
 import numpy as np
 from scipy import integrate, special
 
-from clutchocp.simulation.vectorized import register_table
 
-from .backend import erfc, exp, fmax, fmin, if_else, is_symbolic, log, softplus, sqrt
+from .backend import apply_elementwise, declare_table, erfc, exp, fmax, fmin, if_else, is_symbolic, log, softplus, sqrt
 
 __all__ = [
     "combined_sigma",
@@ -113,7 +112,7 @@ def _f52_quadrature(H):
 _GRID = np.linspace(_H_LO, _H_HI, round((_H_HI - _H_LO) / _H_STEP) + 1)
 _LOG_TABLE = np.log([_f52_quadrature(H) for H in _GRID])
 _LOG_F52_SPLINE = ca.interpolant("log_F52", "bspline", [_GRID.tolist()], _LOG_TABLE.tolist())
-register_table(_LOG_F52_SPLINE, _GRID)      # outputs and events on many samples: numpy, not de Boor per sample
+declare_table(_LOG_F52_SPLINE, _GRID)      # outputs and events on many samples: numpy, not de Boor per sample
 
 # H -> -inf: F_{5/2}(H) = E[(s + a)^{5/2}], a = -H, = a^{5/2} sum_k C(5/2, 2k) (2k-1)!! a^{-2k}.
 _LO_COEFFS = [special.binom(2.5, 2 * k) * math.prod(range(1, 2 * k, 2)) for k in range(6)]
@@ -139,17 +138,7 @@ def _log_f52_high(H):
 
 def _log_f52_spline(H):
     """Evaluate the B-spline elementwise on floats, arrays or CasADi matrices."""
-    if is_symbolic(H):
-        if H.is_scalar():
-            return _LOG_F52_SPLINE(H)
-        n = H.numel()
-        row = _LOG_F52_SPLINE.map(n)(ca.reshape(H, 1, n))
-        return ca.reshape(row, H.size1(), H.size2())
-    arr = np.asarray(H, dtype=float)
-    if arr.size == 0:
-        return np.empty(arr.shape)
-    values = np.array(_LOG_F52_SPLINE(arr.reshape(1, -1)), dtype=float)
-    return values.reshape(arr.shape)
+    return apply_elementwise(_LOG_F52_SPLINE, H)
 
 
 def log_F52(H):

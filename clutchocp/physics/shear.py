@@ -25,11 +25,13 @@ tests/physics/test_shear.py):
 Units: SI throughout (m, Pa s, rad/s, N m).
 """
 
+import casadi as ca
 import numpy as np
 
-from clutchocp.physics.backend import (exp, fabs, fmax, fmin, if_else, is_symbolic, log, softplus,
-                                       smooth_step)
-from clutchocp.physics.roughness import combined_sigma
+from clutchocp.physics import transmitted_shear_table
+from clutchocp.physics.backend import (apply_elementwise, declare_table, exp, fabs, fmax, fmin, if_else,
+                                       is_symbolic, log, softplus, smooth_step)
+from clutchocp.physics.roughness import average_gap, combined_sigma
 
 EPS_STAR = 1.0 / 300.0          # Cui 2019 after Eq. 6: eps* = 0.00333 (cut-off film / 3 sigma)
 
@@ -193,16 +195,76 @@ def shear_factor_phi_fs(H, sigma_1, sigma_2, smooth=False, width=0.1):
     return _variance_ratio_difference(sigma_1, sigma_2) * _Phi_fs(H, smooth, width)      # Cui Eq. 7
 
 
-def transmitted_shear_factor(H, sigma_1, sigma_2, smooth=False, smooth_cutoff=False, width=0.1):
-    """Shear factor of the torque the film transmits: phi_f + |V_r1 - V_r2| Phi_fs [-].
+# Transmitted factor by deterministic flow: phi_T = 1 + u^2 y(u), u = 1 / (1 + H), y a C2 cubic
+# B-spline through the table (physics/transmitted_shear_table.py) and the far-field value y(0) = 2.5:
+# phi_T -> 1 + 2.5 / H^2, the Couette part E[h / h_loc] = 1 + 1/H^2 plus half the form drag,
+# 6 E[k_x^2 / k^2] (sigma / h)^2 = 3 / H^2 for an isotropic wall (second order in sigma / h).
+FAR_FIELD_TRANSMITTED = 2.5
+_TABLE_U = np.concatenate([[0.0], 1.0 / (1.0 + np.asarray(transmitted_shear_table.H)[::-1])])
+_TABLE_Y = np.concatenate([[FAR_FIELD_TRANSMITTED],
+                           ((np.asarray(transmitted_shear_table.PHI_T) - 1.0)
+                            * (1.0 + np.asarray(transmitted_shear_table.H)) ** 2)[::-1]])
+_TRANSMITTED_SPLINE = ca.interpolant("transmitted_y", "bspline", [_TABLE_U.tolist()], _TABLE_Y.tolist())
+declare_table(_TRANSMITTED_SPLINE, _TABLE_U)    # numpy-translated models evaluate it with numpy
+
+
+def _phi_T(H, smooth, width):
+    """The deterministic-flow transmitted factor phi_T(H), defined over the average gap h_T."""
+    Hp = softplus(H, width) if smooth else fmax(H, 0.0)
+    u = 1.0 / (1.0 + Hp)
+    return 1.0 + u * u * apply_elementwise(_TRANSMITTED_SPLINE, u)
+
+
+def _table_per_H(H, smooth, width=0.05):
+    """phi_T / (h_T / sigma) [-]: the table's transmitted stress over the nominal film, divided by H
+    (finite at H = 0, where h_T / sigma = phi(0) = 0.399; held flat below H = 0 like phi_f / H)."""
+    Hp = softplus(H, width) if smooth else fmax(H, 0.0)
+    return _phi_T(Hp, False, width) / average_gap(Hp, 1.0)
+
+
+SHEAR_FACTOR_METHODS = ("patir_cheng", "table")
+
+
+def _check_method(method):
+    if method not in SHEAR_FACTOR_METHODS:
+        raise ValueError(f"method must be one of {', '.join(SHEAR_FACTOR_METHODS)}, got {method!r}")
+
+
+def _transmitted_per_H(H, sigma_1, sigma_2, method, smooth, smooth_cutoff, width=0.1):
+    """Transmitted factor over the nominal film, divided by H [-] (finite at H = 0)."""
+    phi_f = _phi_f_per_H(H, smooth)
+    if _both_zero(sigma_1, sigma_2):
+        return phi_f
+    asymmetry = fabs(_variance_ratio_difference(sigma_1, sigma_2))                  # |V_r1 - V_r2|
+    if method == "patir_cheng":
+        excess = _Phi_fs(H, smooth or smooth_cutoff, width, power=ALPHA4 - 1.0)
+    else:
+        excess = _table_per_H(H, smooth) - phi_f
+    return phi_f + asymmetry * excess
+
+
+def transmitted_shear_factor(H, sigma_1, sigma_2, method="patir_cheng", smooth=False, smooth_cutoff=False,
+                             width=0.1):
+    """Shear factor of the torque the film transmits, over the nominal film h [-].
 
     The film's momentum balance makes the transmitted stress the same on both plates: the viscous
     shear plus the pressure's form drag on the asperity flanks of a rough wall, the viscous shear
-    alone on a smooth wall. Patir-Cheng's phi_fs lowers the rougher wall's viscous shear by the form
-    drag and raises the smoother wall's by as much, so with one smooth wall the transmitted factor is
-    phi_f + |V_r1 - V_r2| Phi_fs exactly (a rough lining on smooth steel: phi_f + Phi_fs). With two
-    rough walls it is the smoother wall's viscous shear, a lower bound of the transmitted stress (its
-    own form drag is not in Patir-Cheng's factors); with equal roughness phi_fs = 0 and it is phi_f.
+    alone on a smooth wall. The mean transmitted stress is eta U factor / h.
+
+    * ``"patir_cheng"``: phi_f + |V_r1 - V_r2| Phi_fs (Cui Eq. 6-8 with the transmitted sign).
+      Patir-Cheng's phi_fs lowers the rougher wall's viscous shear by the form drag and raises the
+      smoother wall's by as much, so with one smooth wall this is the transmitted factor (a rough
+      lining on smooth steel: phi_f + Phi_fs).
+    * ``"table"``: the deterministic Reynolds flow over an isotropic Gaussian rough wall sliding on a
+      smooth one (:mod:`clutchocp.physics.rough_wall_flow`, table in
+      :mod:`clutchocp.physics.transmitted_shear_table`): phi_T h / h_T, phi_T the mean transmitted
+      stress x h_T / (eta U). It agrees with Patir-Cheng's phi_f + Phi_fs within its scatter at
+      H = 3.5-5 and is 6-48 % above it for H = 0.5-3 (the form drag near contact spots).
+
+    With two rough walls the excess over Patir-Cheng's phi_f is scaled by |V_r1 - V_r2| in both
+    methods (Patir-Cheng's own form; the deterministic flow was computed for one rough wall only), so
+    an equal split gives phi_f: the smoother wall's viscous shear, a lower bound of the transmitted
+    stress.
 
     Parameters
     ----------
@@ -210,9 +272,10 @@ def transmitted_shear_factor(H, sigma_1, sigma_2, smooth=False, smooth_cutoff=Fa
         Film thickness ratio h / sigma [-].
     sigma_1, sigma_2 : float or symbol
         RMS roughness of the two surfaces [m] (the order does not matter).
+    method : {"patir_cheng", "table"}
+        Source of the factor.
     smooth : bool
-        Smooth forms of phi_f and of the cut-off of Phi_fs (:func:`shear_factor_phi_f`,
-        :func:`shear_factor_phi_fs`).
+        Smooth forms of phi_f, of the cut-off of Phi_fs and of the table's clamp at H = 0.
     smooth_cutoff : bool
         The smooth cut-off of Phi_fs even with ``smooth=False``.
     width : float
@@ -221,26 +284,24 @@ def transmitted_shear_factor(H, sigma_1, sigma_2, smooth=False, smooth_cutoff=Fa
     Returns
     -------
     factor : same type as H
-        Transmitted shear factor [-]; the mean transmitted stress is eta U factor / h (nominal h).
+        Transmitted shear factor [-].
     """
-    phi_f = shear_factor_phi_f(H, smooth=smooth)
-    if _both_zero(sigma_1, sigma_2):
-        return phi_f
-    asymmetry = fabs(_variance_ratio_difference(sigma_1, sigma_2))                       # |V_r1 - V_r2|
-    return phi_f + asymmetry * _Phi_fs(H, smooth or smooth_cutoff, width)
+    _check_method(method)
+    return H * _transmitted_per_H(H, sigma_1, sigma_2, method, smooth, smooth_cutoff, width)
 
 
 def viscous_torque(w_rel, h, eta, r1, r2, *, sigma_1=0.0, sigma_2=0.0, area_ratio=0.0,
-                   land_fraction=1.0, smooth=False, smooth_cutoff=False):
+                   land_fraction=1.0, smooth=False, smooth_cutoff=False, method="patir_cheng"):
     """Viscous torque the film between rough annular plates transmits (Cui 2019 Eq. 9, corrected).
 
-    T = (1 - A_c/A_n) psi (phi_f + |V_r1 - V_r2| Phi_fs) pi eta w_rel (r2^4 - r1^4) / (2 h), with
-    H = h/sigma, sigma = sqrt(sigma_1^2 + sigma_2^2) and h the nominal film (the distance of the mean
-    planes). The factor over h is evaluated as (factor / H) / sigma, finite at H = 0; below H = 0
-    (the model's edge: the mean planes cross) it keeps its value at H = 0. Cui Eq. 9 as printed has phi_f - phi_fs (the viscous shear on his surface 1, the rougher
-    friction plate) and the average gap h_T; see the module docstring for both corrections. Bao 2020
-    Eq. 25 writes phi_f + phi_fs and h, as here. With sigma_1 = sigma_2 = 0 (numbers) it is the
-    Newtonian torque pi eta w (r2^4 - r1^4)/(2h).
+    T = (1 - A_c/A_n) psi factor pi eta w_rel (r2^4 - r1^4) / (2 h), with H = h/sigma,
+    sigma = sqrt(sigma_1^2 + sigma_2^2), h the nominal film (the distance of the mean planes) and
+    the factor of :func:`transmitted_shear_factor` (Patir-Cheng: phi_f + |V_r1 - V_r2| Phi_fs). The
+    factor over h is evaluated as (factor / H) / sigma, finite at H = 0; below H = 0 (the model's
+    edge: the mean planes cross) it keeps its value at H = 0. Cui Eq. 9 as printed has phi_f - phi_fs
+    (the viscous shear on his surface 1, the rougher friction plate) and the average gap h_T; see the
+    module docstring for both corrections. Bao 2020 Eq. 25 writes phi_f + phi_fs and h, as here.
+    With sigma_1 = sigma_2 = 0 (numbers) it is the Newtonian torque pi eta w (r2^4 - r1^4)/(2h).
 
     Parameters
     ----------
@@ -260,28 +321,27 @@ def viscous_torque(w_rel, h, eta, r1, r2, *, sigma_1=0.0, sigma_2=0.0, area_rati
     land_fraction : float or symbol, keyword
         Non-grooved fraction psi of the nominal area [-].
     smooth : bool, keyword
-        Use the smooth forms of phi_f and phi_fs.
+        Use the smooth forms of the factors.
     smooth_cutoff : bool, keyword
-        Use the smooth (C2) cut-off of phi_fs at H = 7 even with ``smooth=False``. With unequal
+        Use the smooth (C2) cut-off of Phi_fs at H = 7 even with ``smooth=False``. With unequal
         roughness the exact cut (Cui Eq. 8) is a jump of the torque by Phi_fs(7) = 0.0127 of
         phi_f ~ 1.02, which an integrator has to step across (a stiff compliant-shaft DAE cannot);
         the smooth cut differs by < 5e-5 relative for H <= 6.5 and < 1e-6 absolute for H >= 7.5.
+    method : {"patir_cheng", "table"}, keyword
+        Source of the transmitted factor (:func:`transmitted_shear_factor`).
 
     Returns
     -------
     T : same type as w_rel
         Viscous torque [N m], same sign as w_rel.
     """
+    _check_method(method)
     if _both_zero(sigma_1, sigma_2):
         per_film = 1.0 / h                                                   # Newtonian: 1 / h
     else:
         # factor / h = (factor / H) / sigma, written so that it stays finite at H = 0
         sigma = combined_sigma(sigma_1, sigma_2)
-        H = h / sigma
-        asymmetry = fabs(_variance_ratio_difference(sigma_1, sigma_2))      # |V_r1 - V_r2|
-        per_H = (_phi_f_per_H(H, smooth)
-                 + asymmetry * _Phi_fs(H, smooth or smooth_cutoff, 0.1, power=ALPHA4 - 1.0))
-        per_film = per_H / sigma
+        per_film = _transmitted_per_H(h / sigma, sigma_1, sigma_2, method, smooth, smooth_cutoff) / sigma
     # Cui 2019 Eq. 9 with the transmitted factor over the nominal film h
     return (1.0 - area_ratio) * land_fraction * np.pi * eta * w_rel * (r2**4 - r1**4) / 2.0 * per_film
 

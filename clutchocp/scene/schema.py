@@ -160,6 +160,13 @@ PARTS = {
                                   default="reduced",
                                   doc="fluid load on the free area (1 - A_c/A_n) W_fluid + p_c A_n (Bao Eq. 12, "
                                       "'reduced') or the full W_fluid + p_c A_n ('additive')"),
+            "shear_factors": Field(kind="choice", choices=("table", "patir_cheng"), required=False,
+                                   default="table",
+                                   doc="transmitted viscous shear factor of a rough lining on a smooth plate: "
+                                       "'table' (default), the deterministic Reynolds flow over Gaussian rough walls "
+                                       "(1 + 2.5/H^2 far out; 6-48 % above Patir-Cheng for H = 0.5-3, equal at "
+                                       "H = 3.5-5), or 'patir_cheng', phi_f + |V_r1 - V_r2| Phi_fs (Cui Eq. 6-8 with "
+                                       "the transmitted sign)"),
             "cavitation_pressure": QOpt("Pa", -1e5, "cavitation_pressure",
                                         doc="lowest mean gauge pressure a film holds when its plates are pulled "
                                             "apart [Pa]; the fluid load is limited smoothly there (the film "

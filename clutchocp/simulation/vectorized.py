@@ -24,6 +24,8 @@ from scipy.special import erf
 
 import casadi as ca
 
+from clutchocp.physics.backend import declared_tables
+
 MIN_SAMPLES = 600      # measured break-even with CasADi's map: ~500 samples (2.4 k and 0.6 k instructions)
 MIN_SAMPLES_PLAIN = 128  # the same for a function without calls of tables: ~50-150 samples (measured on the
                          # seed scenes' outputs and event functions, 3 to 2.6 k instructions); the calls are
@@ -138,6 +140,7 @@ class PiecewiseCubic:
 
 
 _TABLES = {}            # hash of a CasADi table function -> its PiecewiseCubic
+_TAKEN = [0]            # how many of the physics floor's declared tables are registered here
 
 
 def register_table(function, grid):
@@ -145,6 +148,14 @@ def register_table(function, grid):
     with numpy wherever a numpy-translated function calls it (:class:`PiecewiseCubic`); a table
     that is not a cubic on each interval of ``grid`` is left to CasADi (ValueError)."""
     _TABLES[hash(function)] = PiecewiseCubic(function, grid)
+
+
+def _take_declared():
+    """Register the tables the physics floor declared since the last look (``backend.declare_table``)."""
+    declared = declared_tables()
+    for function, grid in declared[_TAKEN[0]:]:
+        register_table(function, grid)
+    _TAKEN[0] = len(declared)
 
 
 def calls_unregistered(function):
@@ -156,6 +167,7 @@ def calls_unregistered(function):
     if not calls:
         return False
     instructions = function.instructions_sx()
+    _take_declared()
     return any(hash(instructions[k].which_function()) not in _TABLES for k in calls)
 
 
@@ -167,6 +179,7 @@ def _call(callee, *args):
     n = int(np.prod(shape)) if shape else 1
     if n == 0:
         return np.zeros(shape)
+    _take_declared()
     table = _TABLES.get(hash(callee))
     if table is not None and len(args) == 1:
         result = table(np.ravel(np.broadcast_to(args[0], shape)))

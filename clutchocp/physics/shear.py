@@ -208,8 +208,28 @@ _TRANSMITTED_SPLINE = ca.interpolant("transmitted_y", "bspline", [_TABLE_U.tolis
 declare_table(_TRANSMITTED_SPLINE, _TABLE_U)    # numpy-translated models evaluate it with numpy
 
 
-def _phi_T(H, smooth, width):
-    """The deterministic-flow transmitted factor phi_T(H), defined over the average gap h_T."""
+def table_shear_factor(H, smooth=False, width=0.05):
+    """The deterministic-flow transmitted factor phi_T(H) of one rough wall on a smooth one [-].
+
+    The mean transmitted stress is eta U phi_T / h_T (h_T the average gap, Bao Eq. 10): the table's
+    own definition (:mod:`clutchocp.physics.transmitted_shear_table`), interpolated as
+    1 + u^2 y(u), u = 1 / (1 + H), y a C2 cubic B-spline through the table with y(0) = 2.5, so
+    phi_T -> 1 + 2.5 / H^2. H <= 0 takes the value at H = 0 (``smooth``: softplus(H, width) for
+    max(H, 0)). :func:`transmitted_shear_factor` gives it over the nominal film.
+
+    Parameters
+    ----------
+    H : float, array or CasADi symbol
+        Film thickness ratio h / sigma [-].
+    smooth : bool
+        Softplus instead of max(H, 0).
+    width : float
+        Softplus width in H [-].
+
+    Returns
+    -------
+    phi_T : same type as H
+    """
     Hp = softplus(H, width) if smooth else fmax(H, 0.0)
     u = 1.0 / (1.0 + Hp)
     return 1.0 + u * u * apply_elementwise(_TRANSMITTED_SPLINE, u)
@@ -219,7 +239,7 @@ def _table_per_H(H, smooth, width=0.05):
     """phi_T / (h_T / sigma) [-]: the table's transmitted stress over the nominal film, divided by H
     (finite at H = 0, where h_T / sigma = phi(0) = 0.399; held flat below H = 0 like phi_f / H)."""
     Hp = softplus(H, width) if smooth else fmax(H, 0.0)
-    return _phi_T(Hp, False, width) / average_gap(Hp, 1.0)
+    return table_shear_factor(Hp, False, width) / average_gap(Hp, 1.0)
 
 
 SHEAR_FACTOR_METHODS = ("patir_cheng", "table")

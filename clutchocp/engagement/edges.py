@@ -168,8 +168,9 @@ def check_contact_capacity(scene, *, max_pressure=None):
         return capacity, pack
     cap = f"{capacity.pressure_Pa / 1e6:.3g} MPa"
     applied = f"{pack.pressure_Pa / 1e6:.3g} MPa"
-    if abs(pack.oil_pressure_Pa * pack.per_oil_pressure - pack.pressure_Pa) > 1e-9 * pack.pressure_Pa:
-        applied += f" on the pack (at {pack.oil_pressure_Pa / 1e6:.3g} MPa of oil, springs included)"
+    if abs(pack.pressure_Pa - pack.oil_pressure_Pa) > 1e-9 * pack.pressure_Pa:
+        springs = ", springs included" if pack.at_zero_oil_Pa else ""
+        applied += f" on the pack (at {pack.oil_pressure_Pa / 1e6:.3g} MPa of oil{springs})"
     limit = (capacity.pressure_Pa - pack.at_zero_oil_Pa) / pack.per_oil_pressure if pack.per_oil_pressure else np.nan
     if pack.per_oil_pressure > 0 and limit > 0:
         change = f"lower {source} below {limit / 1e6:.3g} MPa"

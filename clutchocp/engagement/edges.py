@@ -78,14 +78,15 @@ class PackPressure:
 
 
 def contact_capacity(scene):
-    """The contact's capacity at zero gap (:class:`ContactCapacity`), or None for ``contact.model = "none"``.
+    """The contact's capacity at zero gap (:class:`ContactCapacity`), or None for ``contact.model = "none"``
+    (and for a scene that is not an engagement: its run refuses it).
 
     Parameters
     ----------
     scene : clutchocp.scene.Scene
         An engagement scene.
     """
-    model = scene.variant("contact")
+    model = scene.variant("contact") if scene.kind == "engagement" else ""
     if model not in _LAWS:
         return None
     film = FilmLaw(scene)

@@ -67,3 +67,13 @@ class OutputFolderError(ClutchocpError, ValueError):
 
 class ResourceLimitError(SceneError):
     """A size (output points, plate interfaces ...) beyond what a run can hold in memory and time."""
+
+
+class ModelEdgeError(SolverError):
+    """A run reached the edge of what its model describes (a film gap closed to zero: the contact could not
+    carry the load); the run ends there and reports no result. The message names the part, the time and
+    the cause."""
+
+
+class PlausibilityWarning(UserWarning):
+    """A scene value outside what wet clutches have (``clutchocp.scene.schema.Span``): the run goes on."""

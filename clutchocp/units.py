@@ -74,6 +74,7 @@ DIMENSIONS = {
     "kg m^2": _combine((_KG, 1), (_M, 2)), "J": _J, "W": _W, "m/s": _combine((_M, 1), (_S, -1)),
     "rad": _DIMENSIONLESS, "m^2/s": _combine((_M, 2), (_S, -1)),
     "J/K": _combine((_J, 1), (_K, -1)), "W/m^2/K": _combine((_W, 1), (_M, -2), (_K, -1)),
+    "W/m/K": _combine((_W, 1), (_M, -1), (_K, -1)), "J/kg/K": _combine((_J, 1), (_KG, -1), (_K, -1)),
     "degC": _K,       # a temperature in deg C (the value is returned in deg C, not K)
 }
 

@@ -3,8 +3,8 @@ interval between, the plates keeping their heat, until a number of cycles or a l
 
 One cycle is the scene's engagement run (simulation.t_end, the locked clutch convecting heat to
 the oil after lock-up) started from the plate temperatures the previous cycle left, followed by a
-cooling interval with the clutch open: no heat input, each plate group relaxing to the oil
-temperature with its own time constant C / G (the closed form of the lumped model). The driveline
+cooling interval with the clutch open: no heat input, the plate temperatures relaxing to the oil through the
+lining's conduction chain (its linear system, solved exactly by the matrix exponential). The driveline
 starts every cycle from the scene's speeds, as on an inertia test bench that re-accelerates the
 flywheels between engagements.
 """
@@ -17,7 +17,6 @@ from matplotlib.ticker import MaxNLocator
 
 from ..errors import ModelError, SolverError
 from ..output import new_figure, save_figure, write_csv, write_summary
-from ..physics.thermal import constant_heat_temperature, interface_temperature
 from .model import EngagementModel
 from .run import simulate_engagement
 
@@ -96,22 +95,20 @@ def run_cycles(scene, *, cycles=10, cooling_time=10.0, max_temperature_C=None, p
     if max_temperature_C is not None and not (np.isfinite(max_temperature_C) and max_temperature_C > part.T_start):
         raise ModelError(f"max_temperature_C = {max_temperature_C!r}: must be above the initial plate temperature "
                          f"{part.T_start:g} degC")
-    T_f = T_s = part.T_start
+    plates = dict.fromkeys(part.names, part.T_start)
     rows, reason = [], "cycles"
     for k in range(1, cycles + 1):
         try:
-            run = simulate_engagement(scene, model=model, initial_state={"T_friction": T_f, "T_separator": T_s})
+            run = simulate_engagement(scene, model=model, initial_state=plates)
         except SolverError as err:
-            raise SolverError(f"repeated engagements, cycle {k} (plates at {T_f:.1f} / {T_s:.1f} degC): {err}") from None
+            raise SolverError(f"repeated engagements, cycle {k} (interface at {plates['T_interface']:.1f} degC, "
+                              f"core at {plates['T_core']:.1f} degC): {err}") from None
         s = run.summary
-        # Cooling with the clutch open: no heat, each group relaxes to the oil (closed form).
-        T_f = float(constant_heat_temperature(cooling_time, 0.0, part.C_friction, part.conductance,
-                                              s["final_friction_plate_temperature_C"], part.T_oil))
-        T_s = float(constant_heat_temperature(cooling_time, 0.0, part.C_separator, part.conductance,
-                                              s["final_separator_temperature_C"], part.T_oil))
+        # Cooling with the clutch open: no heat, the chain relaxes to the oil (exact linear solution).
+        plates = part.cooled(s["final_plate_temperatures_C"], cooling_time)
         row = {"cycle": k, "start_interface_temperature_C": float(run.result["interface_temperature_C"][0]),
                "peak_interface_temperature_C": s["peak_interface_temperature_C"],
-               "end_interface_temperature_C": float(interface_temperature(T_s, T_f, part.partition)),
+               "end_interface_temperature_C": plates["T_interface"],
                **{key: s[key] for key in CYCLE_KEYS[4:]}}
         rows.append(row)
         if progress is not None:

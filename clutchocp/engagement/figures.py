@@ -140,22 +140,26 @@ def plot_heat(run, path, *, max_temperature_C=None, max_specific_power_W_mm2=Non
     if max_specific_power_W_mm2 is not None:
         ax.axhline(max_specific_power_W_mm2, color="k", ls="--", lw=0.8, label="limit")
     ax.set(xlabel="time [s]", ylabel="specific power [W/mm^2]",
-           title=f"specific energy {summary['specific_energy_J_mm2']:.3g} J/mm^2 "
+           title=f"specific energy {summary['specific_energy_J_mm2']:.3g} J/mm^2\n"
                  f"over {summary['friction_area_mm2']:.0f} mm^2 of friction area")
     fig.suptitle(f"{summary['scene']}: heat of {what} at the friction interfaces")
     if model.thermal.present:
         hot = axes[0]
-        hot.plot(t, res["interface_temperature_C"], "k", lw=1.5, label="interface (contact)")
-        hot.plot(t, res["T_separator"], "C0", label="separators (bulk)")
-        hot.plot(t, res["T_friction"], "C1", label="friction plates (bulk)")
+        hot.plot(t, res["interface_temperature_C"], "k", lw=1.5, label="interface: lining surface, separator")
+        for j in range(1, model.thermal.cells):
+            hot.plot(t, res[f"T_lining_{j}"], color="C1", lw=0.6, alpha=0.6,
+                     label="inside the lining (surface to core)" if j == 1 else None)
+        hot.plot(t, res["T_core"], "C4", label="friction-plate core")
+        hot.plot(t, res["friction_plate_temperature_C"], "C1", lw=1.5, label="friction plates (bulk)")
         hot.axhline(model.thermal.T_oil, color="C2", ls=":", label="oil")
         if max_temperature_C is not None:
             hot.axhline(max_temperature_C, color="k", ls="--", lw=0.8, label="interface limit")
         hot.set(xlabel="time [s]", ylabel="temperature [degC]",
-                title=f"peak interface temperature {summary['peak_interface_temperature_C']:.1f} degC (lumped)")
+                title=f"peak: interface {summary['peak_interface_temperature_C']:.1f} degC,\nfriction plates "
+                      f"{summary['peak_friction_plate_temperature_C']:.1f} degC (bulk)")
         if summary["engagement_time_s"] is not None:
             hot.axvline(summary["engagement_time_s"], color="0.5", lw=0.8, ls="--", label="lock-up")
-        hot.legend(fontsize=8)
+        hot.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0)
     return _finish(fig, ax, run, path)
 
 

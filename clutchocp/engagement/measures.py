@@ -166,6 +166,7 @@ def summarize(model, result, wall_time, options, method):
     }
     summary.update(film_pressure_summary(model, result))
     summary.update(thermal_summary(model, result))
+    summary["warnings"] = list(model.scene.warnings)
     return summary
 
 
@@ -203,11 +204,16 @@ def thermal_summary(model, result):
            "peak_specific_power_W_mm2": float(np.max(heat)) / area_mm2}
     out["specific_energy_J_mm2"] = out["interface_heat_J"] / area_mm2
     if model.thermal.present:
-        temperature = result["interface_temperature_C"]
+        # The interface is the lining's surface (and the lumped separator in contact with it); the
+        # friction plates' bulk is their heat-capacity-weighted mean, lining and core.
+        temperature, bulk = result["interface_temperature_C"], result["friction_plate_temperature_C"]
         k = int(np.argmax(temperature))
         out.update({"peak_interface_temperature_C": float(temperature[k]),
                     "peak_interface_temperature_time_s": float(result.t[k]),
+                    "peak_friction_plate_temperature_C": float(np.max(bulk)),
+                    "peak_core_temperature_C": float(np.max(result["T_core"])),
                     "final_interface_temperature_C": float(temperature[-1]),
-                    "final_friction_plate_temperature_C": float(result.final("T_friction")),
-                    "final_separator_temperature_C": float(result.final("T_separator"))})
+                    "final_friction_plate_temperature_C": float(bulk[-1]),
+                    "final_separator_temperature_C": float(temperature[-1]),
+                    "final_plate_temperatures_C": {name: float(result.final(name)) for name in model.thermal.names}})
     return out

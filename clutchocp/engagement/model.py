@@ -10,7 +10,8 @@ shape); a part that the scene does not declare adds no state:
     w_in              input speed                              (driveline.input = "inertia")
     w_out             output speed                             (driveline.output = "inertia")
     theta_shaft       output shaft twist                       (driveline.shaft_stiffness given)
-    T_friction, T_separator  plate temperatures [degC]         (a [thermal] part)
+    T_interface, T_lining_1 .. T_lining_{N-1}, T_core
+                      plate temperatures [degC]: interface, inside the lining, core  (a [thermal] part)
     E_*               energy accumulators for the balance check: source, hydraulic, slip, film,
                       contact, impact (always); load (a load on an output inertia), seal (a
                       piston), spline (splines), shaft (a compliant shaft), convection (a
@@ -19,6 +20,9 @@ shape); a part that the scene does not declare adds no state:
 Modes are (axial phase) x (rotation): axial phase "approach" (piston travelling freely, plates at
 rest; only with a piston and free travel) or "pressing"; rotation "slip_forward" (w_in > w_out),
 "slip_reverse" or "locked"; a mode is named "<axial>_<rotation>". Events move between them: impact (Bao Eq. 22), lock-up and unlock.
+Every mode also watches each film gap: a gap reaching zero is the model's edge (the asperity contact
+could not carry the load, or there is none), so the event ``film_closed`` ends the run with a
+:class:`~clutchocp.errors.ModelEdgeError` instead of a result (:mod:`clutchocp.engagement.edges`).
 
 The piston (or its stand-in, which presses the pack with the pressure force p A) and the pack (plate
 masses or massless) are parts picked once from the scene (:mod:`clutchocp.engagement.piston`,
@@ -424,6 +428,10 @@ class EngagementModel:
         torque_scale = max(abs(self.scene.get("driveline.input_torque", 0.0)), 10.0)
         if axial == "approach":
             events.append(self.piston.impact_event(self.state, rotation, self.pack, self.H0))
+        else:
+            mode = f"{axial}_{rotation}"
+            events += [Event("film_closed", self.state(f"h_{i + 1}"), mode, direction=-1, scale=self.sigma,
+                             edge=f"film {i + 1} closed (gap h_{i + 1} = 0)") for i in range(self.n)]
         needed = self.locked_torque()
         margin = capacity - ca.fabs(needed)
         if rotation == "locked":

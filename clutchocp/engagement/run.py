@@ -7,13 +7,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError, SolverError
+from ..errors import ModelEdgeError, ModelError, SolverError
 from ..simulation.result import Table, unit_of
 from ..simulation import SimulationOptions, simulate
 from ..scene import load_scene
 from ..scene.loader import check_value
 from ..scene.schema import PARTS
 from ..output import save_figure
+from .edges import check_contact_capacity, contact_capacity
 from .measures import summarize   # also imported from here by the optimal, shift-control and study floors
 from .model import EngagementModel
 
@@ -121,7 +122,7 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
         ``{"max_wall_time": 10.0}`` (a wall-time cap [s]) or ``{"event_value_tol": 1e-10}``.
     initial_state : dict, optional
         ``{state name: value}`` replacing the scene's initial values (e.g. the plate temperatures
-        ``T_friction``, ``T_separator`` [degC] of a repeated engagement).
+        plate temperatures ``T_interface`` .. ``T_core`` [degC] of a repeated engagement).
     parameters : dict, optional
         Values of the free parameters of ``model.hybrid`` (a model built with scene values as
         CasADi symbols, :mod:`clutchocp.study.parametric`), SI.
@@ -129,10 +130,20 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     Returns
     -------
     EngagementResult
+
+    Raises
+    ------
+    PhysicalRangeError
+        Before the run: the pack pressure exceeds what the asperity contact carries at zero gap
+        (:func:`~clutchocp.engagement.edges.check_contact_capacity`).
+    ModelEdgeError
+        During the run: a film gap reached zero (the contact could not carry the load); one line naming
+        the film, the time, its load and the contact's capacity.
     """
     if isinstance(scene, (str, Path)):
         scene = load_scene(scene)
     check_run_settings(rtol=rtol, atol=atol, t_end=t_end, output_points=output_points)
+    check_contact_capacity(scene)
     model = model or EngagementModel(scene)
     t_end = t_end or scene.value("simulation.t_end")
     n_out = output_points or scene.value("simulation.output_points")
@@ -155,11 +166,46 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
     try:
         result = simulate(model.hybrid, x0, grid, mode=model.initial_mode(), p=parameters, options=options,
                           method=method)
+    except ModelEdgeError as err:
+        raise explain_edge(model, err) from None
     except SolverError as err:
         raise explain_failure(model, err) from None
     wall = time.perf_counter() - start
     summary = summarize(model, result, wall, options, method)
     return EngagementResult(model, result, summary)
+
+
+def explain_edge(model, err):
+    """The edge event ``err`` (a film gap reached zero) in the engagement's terms: the film, the time, the
+    load the film was pressed with and what the asperity contact carries at zero gap (or that there is
+    none), and what to change. Other edges are returned unchanged."""
+    if getattr(err, "event", None) != "film_closed":
+        return err
+    film, outputs = model.film, err.outputs
+    i = int(err.edge.split()[1])
+    contact = float(film.contact_force(0.0))
+    load = float(outputs[f"film_{i}_fluid_force_N"]) + contact
+    pressed = (f"film load {load / 1e3:.4g} kN = {load / film.area / 1e6:.3g} MPa over its {film.area * 1e6:.0f} "
+               f"mm^2, pack force {float(outputs['pack_force_N']) / 1e3:.4g} kN")
+    capacity = contact_capacity(model.scene)
+    if capacity is None:
+        causes = ["there is no asperity contact to carry the load (contact.model = 'none')"]
+        if film.permeability > 0:
+            causes.append(f"the oil drains through the permeable lining (plates.lining_permeability = "
+                          f"{film.permeability:.3g} m^2)")
+        why = "; ".join(causes) + f" ({pressed})"
+        change = ("give a contact law with roughness (contact.model = 'greenwood_tripp', roughness.sigma of a few "
+                  "um), or plates.lining_permeability = 0, or a lower actuation.pressure")
+    else:
+        why = (f"the contact could not carry the load ({pressed}; {capacity.law} carries at most "
+               f"{contact / 1e3:.4g} kN = {capacity.pressure_Pa / 1e6:.3g} MPa at zero gap, {capacity.data})")
+        change = ("lower actuation.pressure (or the inertia pressing the film), or raise roughness.sigma_* / "
+                  "contact.E_equiv / roughness.asperity_density")
+    new = ModelEdgeError(f"film {i} closed at t = {err.t:.6g} s in mode '{err.mode}': {why}; the model has no "
+                         f"result beyond a closed film. Change: {change}.")
+    for attr in ("t", "mode", "event", "edge", "flag", "states", "outputs"):
+        setattr(new, attr, getattr(err, attr))
+    return new
 
 
 def explain_failure(model, err):

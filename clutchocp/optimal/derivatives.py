@@ -34,6 +34,11 @@ IPOPT_OPTIONS = {"print_level": 0, "sb": "yes", "tol": 1e-8, "max_iter": 500,
 # Warm start from a previous primal-dual solution: start close to the central path. MUMPS' own
 # scaling is switched off there: with it, the warm start of the default problem at N = 400 failed in
 # the step computation after minutes of workspace reallocation (N = 50 .. 200 were unaffected).
+# MUMPS without its own scaling, for the cold start of a problem with plate temperatures (a [thermal] part):
+# with the scaling, the lining's conduction nodes made the KKT factorisations unreliable at N = 100
+# (default_driveline_thermal: 500 iterations without an optimum; default_driveline: Error_In_Step_Computation
+# after 121); without it 32 and 23 iterations (the lumped plates took 31 and 21).
+MUMPS_UNSCALED = {"mumps_permuting_scaling": 0, "mumps_scaling": 0}
 WARM_OPTIONS = {"warm_start_init_point": "yes", "mu_init": 1e-6, "warm_start_bound_push": 1e-9,
                 "warm_start_bound_frac": 1e-9, "warm_start_slack_bound_push": 1e-9,
                 "warm_start_slack_bound_frac": 1e-9, "warm_start_mult_bound_push": 1e-9,

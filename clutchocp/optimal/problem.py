@@ -75,7 +75,7 @@ from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
 from .bound import jerk_lower_bound, output_jerk_share
 from .collocation import DirectCollocation, StagedProblem
-from .derivatives import nlp_solver
+from .derivatives import MUMPS_UNSCALED, nlp_solver
 from .guess import guess_from_optimum, guess_from_run
 from .heat import heat_limits
 from .mesh import graded_mesh, interval_defects
@@ -632,7 +632,8 @@ class EngagementOCP:
             if self._derivatives is None:
                 self._derivatives = phased_derivatives(self.phased)
             self._solvers[key] = nlp_solver(self.phased, warm=warm, name=f"engagement_{key}",
-                                            derivatives=self._derivatives)
+                                            derivatives=self._derivatives,
+                                            ipopt=MUMPS_UNSCALED if self.model.thermal.present and not warm else None)
         return self._solvers[key]
 
     @property

@@ -74,7 +74,7 @@ from .. import interrupt
 from ..engagement.run import simulate_engagement
 from ..errors import ModelError, SolverError
 from .clamp import ClampModel
-from .derivatives import IPOPT_OPTIONS, WARM_OPTIONS
+from .derivatives import IPOPT_OPTIONS, MUMPS_UNSCALED, WARM_OPTIONS
 from .guess import guess_from_run
 from .objective import OBJECTIVE_TERMS, check_weights
 from .parametric import ParametricOCP
@@ -223,7 +223,8 @@ class RobustOCP:
     def solver(self, nlp, warm):
         key = (id(nlp), warm)
         if key not in self._solvers:
-            options = dict(IPOPT_OPTIONS, max_iter=MAX_ITERATIONS, **(WARM_OPTIONS if warm else {}))
+            cold = MUMPS_UNSCALED if self.ocp.model.thermal.present else {}    # as EngagementOCP.solver
+            options = dict(IPOPT_OPTIONS, max_iter=MAX_ITERATIONS, **(WARM_OPTIONS if warm else cold))
             self._solvers[key] = ca.nlpsol(f"robust_{'warm' if warm else 'cold'}", "ipopt", nlp.nlp,
                                            {"print_time": False, "ipopt": options, "error_on_fail": False,
                                             # stops IPOPT at the next iteration after a Ctrl-C

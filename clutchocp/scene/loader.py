@@ -7,6 +7,7 @@ names the field and what is allowed.
 
 import math
 import tomllib
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,7 @@ from ..errors import (
     MissingParameterError,
     ParameterTypeError,
     PhysicalRangeError,
+    PlausibilityWarning,
     SceneError,
     SceneNotFoundError,
     UnknownKeyError,
@@ -23,7 +25,7 @@ from ..errors import (
 from ..physics.friction import CHEN_THETA_MIN
 from ..physics.viscosity import walther_coefficients, walther_kinematic_viscosity
 from .fields import check_value, parse_field, suggest  # noqa: F401 - check_value: engagement.run reads it here
-from .schema import PARTS, REQUIRED_PARTS
+from .schema import LINING_MATERIALS, PARTS, REQUIRED_PARTS, RETIRED
 from .uncertainty import Uncertainty
 
 # The table of a scene that declares its uncertain fields (see clutchocp.scene.uncertainty), not a part.
@@ -83,7 +85,7 @@ def read_toml(name_or_path, folder, what):
         raise SceneError(f"{path.name}: not a UTF-8 text file") from None
 
 
-def _validate_part(part_name, table):
+def _validate_part(part_name, table, notes=None):
     part = PARTS[part_name]
     if not isinstance(table, dict):
         raise ParameterTypeError(f"[{part_name}]: expected a table of parameters, got {table!r}")
@@ -101,6 +103,8 @@ def _validate_part(part_name, table):
     for key in table:
         if key == "model" and part.variants:
             continue
+        if f"{part_name}.{key}" in RETIRED:
+            raise UnknownKeyError(f"{part_name}.{key}: no longer a key: {RETIRED[f'{part_name}.{key}']}")
         if key not in allowed:
             where = f"{part_name} (model = {variant})" if variant else part_name
             options = sorted(allowed) + (["model"] if part.variants else [])
@@ -112,7 +116,7 @@ def _validate_part(part_name, table):
     for key, spec in sorted(allowed.items(), key=lambda item: item[0] != "density"):
         name = f"{part_name}.{key}"
         if key in table:
-            values[key] = parse_field(name, table[key], spec, density=values.get("density"))
+            values[key] = parse_field(name, table[key], spec, density=values.get("density"), notes=notes)
         elif spec.required:
             raise MissingParameterError(f"{name}: missing required parameter ({spec.doc})")
         elif spec.default is not None:
@@ -203,6 +207,7 @@ def _check_temperatures(values):
         if values["scene"]["kind"] != "engagement":
             raise SceneError("[thermal]: plate temperatures are modelled for engagement scenes only")
         thermal.setdefault("initial_temperature_C", thermal["oil_temperature_C"])
+        _check_lining(values)
     if friction.get("model") == "chen2021":
         _fixed_temperature("friction", friction, thermal is not None, "Chen's law reads the interface temperature")
         for key in ("oil_temperature_C", "initial_temperature_C") if thermal is not None else ():
@@ -218,6 +223,27 @@ def _check_temperatures(values):
         raise PhysicalRangeError(f"oil.kinematic_viscosity_40C, oil.kinematic_viscosity_100C: {exc}") from None
     theta = thermal["oil_temperature_C"] if thermal is not None else oil["temperature_C"]
     oil["viscosity"] = oil["density"] * float(walther_kinematic_viscosity(theta, A, B))
+
+
+def _check_lining(values):
+    """The lining the [thermal] part conducts heat through: its properties (defaults from
+    ``thermal.lining_material``), a thickness, and a friction-plate heat capacity that holds it."""
+    thermal, plates = values["thermal"], values["plates"]
+    for key, default in zip(("lining_conductivity", "lining_density", "lining_specific_heat"),
+                            LINING_MATERIALS[thermal["lining_material"]]):
+        thermal.setdefault(key, default)
+    d = plates["lining_thickness"]
+    if not d > 0:
+        raise MissingParameterError("plates.lining_thickness: must be > 0 with a [thermal] part (the heat of the "
+                                    "interface conducts through the friction lining); e.g. '0.5 mm' for paper")
+    lining = (plates["n_interfaces"] * math.pi * (plates["r_outer"] ** 2 - plates["r_inner"] ** 2) * d
+              * thermal["lining_density"] * thermal["lining_specific_heat"])
+    if thermal["friction_plate_heat_capacity"] < lining:
+        raise PhysicalRangeError(
+            f"thermal.friction_plate_heat_capacity = {thermal['friction_plate_heat_capacity']:g} J/K is less than "
+            f"the linings alone hold ({lining:.4g} J/K = n_interfaces x pi (r_outer^2 - r_inner^2) x "
+            f"plates.lining_thickness x lining_density x lining_specific_heat): give the heat capacity of the "
+            f"friction plates with their steel cores")
 
 
 def _fixed_temperature(part, table, has_thermal, with_thermal):
@@ -240,12 +266,14 @@ class Scene:
         self.raw = raw
         self.path = Path(path) if path else None
         self._uncertainty = None
+        notes = []
         try:
-            self._values = validate(raw, self.path.parent if self.path else Path.cwd())
+            self._values = validate(raw, self.path.parent if self.path else Path.cwd(), notes)
         except SceneError as exc:
             if self.path is None:
                 raise
             raise type(exc)(f"{self.path.name}: {exc}") from None
+        self.warnings = tuple(notes)
 
     @property
     def name(self):
@@ -354,8 +382,12 @@ def _roughness_overrides(scene, overrides):
     return out
 
 
-def validate(raw, base_dir):
-    """Validate a parsed scene dictionary; return {part: {key: SI value}}."""
+def validate(raw, base_dir, notes=None):
+    """Validate a parsed scene dictionary; return {part: {key: SI value}}.
+
+    Values outside their key's typical span (:class:`~clutchocp.scene.schema.Span`) add a line to the
+    list ``notes``; values outside its limits are refused.
+    """
     if not isinstance(raw, dict):
         raise ParameterTypeError("scene: expected TOML tables")
     raw = {part: table for part, table in raw.items() if part != UNCERTAINTY}
@@ -365,7 +397,7 @@ def validate(raw, base_dir):
                                   f"(allowed: {', '.join(PARTS)}, {UNCERTAINTY})")
     if "scene" not in raw:
         raise MissingParameterError("[scene]: missing part (name, source and kind are required)")
-    values = {part: _validate_part(part, table) for part, table in raw.items()}
+    values = {part: _validate_part(part, table, notes) for part, table in raw.items()}
     _cross_check(values, base_dir)
     return values
 
@@ -395,10 +427,15 @@ def load_scene(name_or_path, overrides=None):
     Returns
     -------
     Scene
+        Its values outside what wet clutches have are in ``Scene.warnings`` and issued as
+        :class:`~clutchocp.errors.PlausibilityWarning`.
     """
     path, raw = read_toml(name_or_path, "models", "scene")
     scene = Scene(raw, path)
-    return scene.with_overrides(overrides) if overrides else scene
+    scene = scene.with_overrides(overrides) if overrides else scene
+    for note in scene.warnings:
+        warnings.warn(f"{scene.name}: {note}", PlausibilityWarning, stacklevel=2)
+    return scene
 
 
 def list_scenes():

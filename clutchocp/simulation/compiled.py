@@ -31,6 +31,7 @@ class EventSpec:
     direction: int
     target: str
     key: int            # index of the first event with the same function and scale (shared location)
+    edge: str = ""      # non-empty: firing ends the run (Event.edge)
 
 
 def _column(exprs):
@@ -203,7 +204,7 @@ class CompiledMode:
             fun = ca.SX(ev.function)
             key = next((j for j, e in enumerate(mode.events[:i])
                         if e.scale == ev.scale and ca.is_equal(ca.SX(e.function), fun, 16)), i)
-            self.events.append(EventSpec(i, ev.name, ev.direction, ev.target, key))
+            self.events.append(EventSpec(i, ev.name, ev.direction, ev.target, key, ev.edge))
             functions.append(fun / ev.scale)
         self.f_events = _function(f"{self.name}_events", args, [ca.densify(scaled(functions))], "an event function",
                                   self.name)

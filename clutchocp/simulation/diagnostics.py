@@ -4,7 +4,7 @@ import re
 
 import numpy as np
 
-from clutchocp.errors import SolverError
+from clutchocp.errors import ModelEdgeError, SolverError
 
 _RESIDUAL = (("the equations gave NaN or Inf: an expression left its domain (log or sqrt of a negative "
               "number, division by zero), e.g. a gap closed without an event"),
@@ -81,4 +81,18 @@ def solver_error(solver, flag, t, cm, xs, zs=None, detail=""):
     err = SolverError(message)
     err.t, err.mode, err.flag = float(t), cm.name, flag
     err.states = cm.x_dict(xs)
+    return err
+
+
+def edge_error(spec, t, cm, xs, zs, outputs):
+    """Build a :class:`~clutchocp.errors.ModelEdgeError` for the edge event ``spec`` (a compiled
+    :class:`~clutchocp.simulation.compiled.EventSpec` with ``edge`` text) fired at time ``t`` in mode ``cm``.
+
+    The error carries ``t``, ``mode``, ``event`` (its name), ``edge`` (its text), ``states`` (unscaled)
+    and ``outputs`` (the mode's outputs there), so that the model's own layer can say why in its terms.
+    """
+    err = ModelEdgeError(f"{spec.edge} at t = {t:.9g} s in mode '{cm.name}': the model has no result beyond it")
+    err.t, err.mode, err.event, err.edge, err.flag = float(t), cm.name, spec.name, spec.edge, "edge"
+    err.states = cm.x_dict(xs)
+    err.outputs = outputs
     return err

@@ -6,7 +6,7 @@ import numpy as np
 
 from clutchocp import interrupt
 from clutchocp.errors import ModelError, SolverError
-from clutchocp.simulation.diagnostics import solver_error
+from clutchocp.simulation.diagnostics import edge_error, solver_error
 from clutchocp.simulation.events import ARMED, PASSED, EventMonitor
 from clutchocp.simulation.idas_path import IdasPath
 from clutchocp.simulation.model import PiecewiseConstant
@@ -246,6 +246,8 @@ class _Run:
 
     def _switch(self, i, iterations):
         cm, spec, t = self.cm, self.cm.events[i], self.t
+        if spec.edge:                   # the model's edge: the run ends here, no result beyond it
+            raise edge_error(spec, t, cm, self.xs, self.zs, self._outputs(cm, self.xs, self.zs))
         last, count = self._instant
         count = count + 1 if last is not None and abs(t - last) <= self.opts.event_time_tol else 1
         self._instant = (t, count)

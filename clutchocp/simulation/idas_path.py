@@ -442,6 +442,8 @@ class IdasPath:
         best = math.inf
         for i, spec in enumerate(cm.events):
             state = monitor.state[i]
+            if spec.edge:               # an edge of the model ends the run: found on the samples, never planned for
+                continue
             if state == ARMED:
                 offset = 0.0
             elif state == ENTRY and spec.direction != 0:

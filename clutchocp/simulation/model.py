@@ -53,6 +53,12 @@ class Event:
     scale : float
         Nominal size of the function: tolerances and the hysteresis band apply to
         ``function / scale``.
+    edge : str
+        Non-empty: the crossing is an edge of the model's validity (e.g. "film 2 closed"), not a switch.
+        When it fires the run ends with a :class:`~clutchocp.errors.ModelEdgeError` carrying this text,
+        the time, the mode, the states and the outputs there; ``target`` and ``reset`` are not used.
+        Such an event does not shorten the integrator's calls (its crossing is found on the samples,
+        then located), so a run that never reaches the edge costs no more than without it.
     """
 
     name: str
@@ -62,6 +68,7 @@ class Event:
     reset: Mapping[str, ca.SX] | None = None
     guard: ca.SX | None = None
     scale: float = 1.0
+    edge: str = ""
 
     def __post_init__(self):
         if self.direction not in DIRECTIONS:

@@ -53,15 +53,16 @@ def test_cooling_interval_follows_the_exact_solution(scene):
 def test_drift_and_temperature_limit(scene):
     result = run_cycles(scene, cycles=10, cooling_time=0.5, max_temperature_C=90.0)
     assert result.stop_reason == "temperature limit"
-    assert len(result.cycles) == 2                      # 81.6 degC, then 101.0 degC
+    assert len(result.cycles) == 3                      # 70.3, 86.1, then 95.8 degC
     times = [c["engagement_time_s"] for c in result.cycles]
     # A real drift, far above the event tolerance (1e-9 s). Its sign depends on the film regime: within
     # one engagement the heating thins the oil and slows the lock-up (less viscous torque), but a cycle
-    # that starts hot also drains its films sooner; with the lining rough and the separator smooth
-    # (phi_fs lowers the viscous share) the second effect wins: 0.3032 s, then 0.2924 s.
-    assert abs(times[1] - times[0]) > 1e-3
+    # that starts hot also drains its films sooner; with the transmitted shear factor of the rough lining
+    # (the viscous torque carries a large share of the slip) the first effect wins: 0.1830 s, 0.2002 s,
+    # then 0.2106 s.
+    assert times[1] > times[0] + 1e-3 and times[2] > times[1]
     summary = result.summary()
-    assert summary["engagement_time_drift_s"] == pytest.approx(times[1] - times[0])
+    assert summary["engagement_time_drift_s"] == pytest.approx(times[-1] - times[0])
 
 
 def test_errors(scene, default_without_thermal):

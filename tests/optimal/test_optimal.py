@@ -113,11 +113,6 @@ def test_energy_limit_is_respected(ocp, opt):
     assert limited.objective > opt.objective                                # the limit costs objective
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "measured: the default optimum now rides the film tension limit (its films at -1.01 bar) and its objective "
-    "converges at first order in the intervals: |J(N) - J(120)| = 0.0672 at N = 20, 0.0352 at N = 40 (ratio "
-    "1.9); with the limit out of reach (film.cavitation_pressure = -10 bar, films at -2.3 bar) 0.0430 and "
-    "0.0160 (ratio 2.7)"))
 def test_collocation_error_falls_as_intervals_grow(scene, ocp, opt):
     fine = EngagementOCP(scene, intervals=120, degree=3, baseline=ocp.baseline).solve(guess=opt)
     coarse = EngagementOCP(scene, intervals=20, degree=3, baseline=ocp.baseline).solve(guess=opt)

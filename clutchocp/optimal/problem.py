@@ -74,6 +74,8 @@ from ..errors import ModelError, SolverError
 from .bound import jerk_lower_bound, output_jerk_share
 from .collocation import DirectCollocation, StagedProblem
 from .derivatives import nlp_solver
+from .feasibility import (check_heat, check_pack, film_floor, hardest_command, holding_capacity,
+                          locked_torque_at_lock, plate_force, spring_applied, usable_pressure)
 from .guess import guess_from_optimum, guess_from_run
 from .heat import heat_limits
 from .mesh import graded_mesh, interval_defects
@@ -258,6 +260,17 @@ class EngagementOCP:
             if start_mode == FILL_MODE else None
         # Output held (a brake): the braked side is the input; its jerk is the one felt.
         self.output_held = not self.model.output_inertia and self.model.input_inertia
+        # The torque the locked driveline carries, at the lock-up speed (a load that rises with speed
+        # carries more there than at the start), and what the pack can hold against it: checked before
+        # any run (:mod:`clutchocp.optimal.feasibility`).
+        self.lock_torque = locked_torque_at_lock(self.model)
+        check_pack(self)
+        # Films stay above a floor where the contact cannot carry the largest plate pressure at zero
+        # gap: at h = 0 the contact law ends (the model's edge) and the Patir-Cheng shear factor's
+        # third derivative (H^2.31) is infinite there, a NaN in the Hessian of the jerk term.
+        floor = film_floor(self.model.film, plate_force(self.model, hardest_command(self.model, self.p_max))
+                           / self.model.film.area)
+        self.h_min = max(h_min or 0.0, floor) or h_min
         self.baseline = baseline if baseline is not None else simulate_engagement(scene)
         self._fastest = None
         # The run that seeds the first solve and sets the scales: the baseline if it locks up.
@@ -266,7 +279,6 @@ class EngagementOCP:
         self.rate_limit = self.p_max / 0.01 if rate_limit is None else float(rate_limit)
         if not self.rate_limit > 0:
             raise ModelError(f"rate_limit = {rate_limit!r}: must be a positive rate [Pa/s]")
-        self.h_min = h_min
         self.output_jerk_share = 1.0 if self.output_held else output_jerk_share(scene)
         self.has_valve = self.model.actuation.has_state
         self.state_groups = self._state_groups(self.model)
@@ -283,6 +295,7 @@ class EngagementOCP:
         self.nlp = self.phased.parts[0] if len(self.phased.parts) == 1 else self.phased
         self._solvers = {}
         self._derivatives = None
+        self._relaxed = None
 
     # -- set-up ---------------------------------------------------------------------------------
     def _state_groups(self, model):
@@ -326,7 +339,7 @@ class EngagementOCP:
         summary = self.reference_run.summary
         t_ref = summary["engagement_time_s"]
         w_rel0, rate0 = self.initial_slip(model)
-        locked0 = float(ca.Function("locked", [model.x], [model.locked_torque()])(model.initial_state))
+        locked0 = self.lock_torque
         jerk_ref = jerk_lower_bound(w_rel0, rate0, t_ref) * max(self.output_jerk_share, 1e-3) ** 2
         peak = summary["peak_torque_Nm"]
         # A lock that carries (almost) no torque: the jump is the slipping torque before it, measured
@@ -490,7 +503,7 @@ class EngagementOCP:
             # with the pressure and let it go, a 20 m/s kiss. A pressure-applied piston gets no bound:
             # its optimum does not move back, and an inactive bound (at 1 or 10 % of the stroke)
             # made IPOPT take 262 or 111 iterations instead of 47 on default_fill.
-            if self.apply_pressure == 0.0:
+            if self.spring_applied:
                 i_x0 = self._names.index("x0")
                 x_lb[i_x0] = -0.1 * self.model.travel / self.nominal[i_x0]
             end_lb, end_ub = np.zeros(1), np.zeros(1)
@@ -523,9 +536,28 @@ class EngagementOCP:
             phases.append(Phase(name, mode, self.staged_problem(name), tr))
         links = [self.impact_link()] if len(phases) > 1 else []
         nlp = PhasedNLP(phases, links)
-        if len(phases) > 1 and self.apply_pressure == 0.0:
+        if len(phases) > 1 and self.spring_applied:
             self._bound_films_by_the_gap(nlp)
+            self._bound_piston_by_the_kiss(nlp)
         return nlp
+
+    def _bound_piston_by_the_kiss(self, nlp):
+        """Fill phase of a spring-applied piston: the piston not past the kiss point, x0 <= travel.
+
+        The fill mode has no plates, so without this bound its optimum may carry the piston past the
+        kiss point and back, to end the phase at x0 = travel moving backwards; IDAS meets the kiss at
+        the first crossing instead. Measured on the catalogue's helicopter_spring_applied_90C: a
+        collocation kiss at 0.043 s at -0.083 m/s against IDAS's at 0.0099 s at +0.31 m/s, and IDAS
+        locking 2.6 % early with a jump of 15 % of the locked torque. The phase's end (node N and the
+        last Radau point, equal to it), where the end condition sets x0 = travel, is left free.
+        """
+        part, off = nlp.parts[0], int(nlp.offsets[0])
+        n_x = part.problem.n_x
+        (xs, (n_nodes, _)), (xcs, (N, d, _)) = part.layout["x"], part.layout["xc"]
+        i = self._names.index("x0")
+        kiss = self.model.travel / self.nominal[i]
+        nlp.ubx[off + xs + i:off + xs + (n_nodes - 1) * n_x:n_x] = kiss                  # nodes 0 ... N-1
+        nlp.ubx[off + xcs + i:off + xcs + (N * d - 1) * n_x:n_x] = kiss                  # all points but the last
 
     def _bound_films_by_the_gap(self, nlp):
         """Slip phase of a spring-applied piston: no film thicker than its gap at the kiss, H0.
@@ -627,6 +659,19 @@ class EngagementOCP:
         twin._fastest = self._fastest
         return twin
 
+    def relaxed(self):
+        """The same problem (same meshes) with the lock-up jump as a penalty instead of an end condition,
+        built once: the start of :func:`clutchocp.optimal.strategy.solve_robustly` where this one fails."""
+        if self._relaxed is None:
+            tr = self.transcription
+            meshes = {name: part.transcription.mesh for (name, _), part in zip(self.phase_modes, self.phased.parts)}
+            options = dict(self.options, jump="penalty", meshes=meshes, intervals=tr.intervals, degree=tr.degree,
+                           scheme=tr.scheme, control=tr.control)
+            self._relaxed = EngagementOCP(self.scene, smooth=self.smooth, polish=False, baseline=self.baseline,
+                                          models=self.models, **options)
+            self._relaxed._fastest = self._fastest
+        return self._relaxed
+
     def with_meshes(self, meshes):
         """The same problem on other meshes (``{phase name: interval shares}``); the baseline is shared."""
         tr = self.transcription
@@ -674,6 +719,7 @@ class EngagementOCP:
         if not (t_max > 0):
             raise ModelError(f"t_max = {t_max!r}: must be a positive time [s]")
         self.check_feasible_time(t_max)
+        check_heat(self, t_max, min(t_max, self.fastest_lockup()) if self.heat_limits else t_max)
         if e_max is not None and not (np.isfinite(e_max) and e_max > 0):
             raise ModelError(f"e_max = {e_max!r}: must be a positive energy [J]")
         result = self._solve_stage(t_max, e_max, weights, guess)
@@ -687,7 +733,9 @@ class EngagementOCP:
                             warm_start=stages[0]["warm_start"], iterations=sum(s["iterations"] for s in stages),
                             wall_time_s=sum(s["wall_time_s"] for s in stages), stages=stages)
         if not result.success:
-            raise SolverError(self._failure_message(result.stats, t_max))
+            error = SolverError(self._failure_message(result.stats, t_max))
+            error.status = result.stats["status"]
+            raise error
         return result
 
     def _solve_stage(self, t_max, e_max, weights, guess):
@@ -744,18 +792,11 @@ class EngagementOCP:
                                                     for a, b in zip(opt.meshes, mine))
 
     def _failure_message(self, stats, t_max):
+        """One line for a solve that ended without an optimum: what the solver's status means for the user."""
         status = stats["status"]
         where = (f"scene '{self.scene.name}', t_max = {t_max:.4g} s, {self.transcription.intervals} intervals, "
                  f"{stats['iterations']} iterations")
-        if status == "Infeasible_Problem_Detected":
-            hint = (f"no command within the pressure and rate limits locks up by t_max with the end conditions "
-                    f"(the fastest lock-up, a step to {self._apply_label()}, takes {self.fastest_lockup():.4g} s); "
-                    f"raise t_max, e_max or the limits")
-        elif status == "Maximum_Iterations_Exceeded":
-            hint = "start from a nearby solution (warm start) or use fewer intervals"
-        else:
-            hint = "try another t_max, more intervals or other weights"
-        return f"optimal engagement: IPOPT stopped with {status} ({where}); {hint}"
+        return f"optimal engagement: no optimum found ({where}): {solver_verdict(status)}"
 
     def _result(self, w, lam_x, lam_g, objective, weights, stats):
         sc = self.scales
@@ -874,6 +915,16 @@ class EngagementOCP:
             return 1.5 * self.fastest_lockup()
         return t_lock
 
+    def default_t_max_source(self):
+        """Where :meth:`default_t_max` comes from, in words (for progress lines and summary.json)."""
+        t_lock = self.baseline.summary["engagement_time_s"]
+        if t_lock is None:
+            return f"1.5 x the fastest lock-up (a step to {self.apply_label()}): the scene's own profile does not lock up"
+        if t_lock <= 1.001 * self.fastest_lockup():
+            return (f"1.5 x the fastest lock-up (a step to {self.apply_label()}): the scene's own profile locks up "
+                    f"no later than that")
+        return "the lock-up time of the scene's own profile"
+
     def fastest_run(self):
         """IDAS run of a step of the command to the pressure that applies the clutch hardest (cached):
         the pressure limit, or zero for a spring-applied piston (the pressure releases it)."""
@@ -881,20 +932,36 @@ class EngagementOCP:
             t_end = self.scene.value("simulation.t_end")
             run = simulate_command(self.scene, [0.0], [self.apply_pressure], t_end, model=self.models.replay())
             if run.summary["engagement_time_s"] is None:
-                raise ModelError(f"scene '{self.scene.name}': even a step to {self._apply_label()} does not lock "
-                                 f"up within simulation.t_end = {t_end:g} s; raise the pressure limit or t_end")
+                capacity = holding_capacity(self.model, self.apply_pressure)[0]
+                raise ModelError(f"scene '{self.scene.name}': even a step to {self.apply_label()} does not lock up "
+                                 f"within simulation.t_end = {t_end:g} s (the pack holds {capacity:.4g} N m there, "
+                                 f"the locked driveline needs {abs(self.lock_torque):.4g} N m); raise simulation.t_end "
+                                 f"(--set simulation.t_end=...) or actuation.max_pressure")
             self._fastest = run
         return self._fastest
 
     @property
-    def apply_pressure(self):
-        """Command that applies the clutch hardest [Pa]: 0 for a spring-applied piston, else the limit."""
-        spring_applied = self.model.has_piston and self.scene.variant("piston") == "spring_applied"
-        return 0.0 if spring_applied else self.p_max
+    def spring_applied(self):
+        """True for a spring-applied piston (the pressure releases the clutch)."""
+        return spring_applied(self.model)
 
-    def _apply_label(self):
-        return "zero pressure (spring-applied)" if self.apply_pressure == 0.0 else \
-            f"actuation.max_pressure = {self.p_max / 1e6:.3g} MPa"
+    @property
+    def apply_pressure(self):
+        """Command that applies the clutch hardest [Pa]: 0 for a spring-applied piston, else the limit;
+        where the contact cannot carry that at zero gap, the command whose settled plate pressure is the
+        contact's at the film floor (:func:`~clutchocp.optimal.feasibility.usable_pressure`)."""
+        return usable_pressure(self.model, self.p_max)
+
+    def apply_label(self):
+        """The command that applies the clutch hardest, in words (for messages)."""
+        p = self.apply_pressure
+        if self.spring_applied:
+            return "zero pressure (spring-applied)" if p == 0.0 else \
+                f"{p / 1e6:.4g} MPa (spring-applied; the contact carries no more at a positive film)"
+        if p < self.p_max:
+            return (f"{p / 1e6:.4g} MPa (the most the contact carries at a positive film; actuation.max_pressure "
+                    f"= {self.p_max / 1e6:.4g} MPa)")
+        return f"actuation.max_pressure = {self.p_max / 1e6:.4g} MPa"
 
     def fastest_lockup(self):
         """Lock-up time [s] of a step to :attr:`apply_pressure` (no command within the limits locks sooner)."""
@@ -909,9 +976,28 @@ class EngagementOCP:
             return
         fastest = self.fastest_lockup()
         if t_max < fastest:
-            raise ModelError(f"t_max = {t_max:.4g} s is below the fastest lock-up the pressure limit allows "
-                             f"({fastest:.4g} s with a step to {self._apply_label()}); "
-                             f"raise t_max or the pressure limit")
+            raise ModelError(f"scene '{self.scene.name}': t_max = {t_max:.4g} s is below the fastest lock-up the "
+                             f"pressure limit allows: --t-max must be at least {fastest:.4g} s for this clutch (a step "
+                             f"to {self.apply_label()} locks up then), or raise actuation.max_pressure")
+
+
+# What an IPOPT status means for the user (its own words stay out of the messages).
+SOLVER_VERDICTS = {
+    "Infeasible_Problem_Detected": "the solver ended at a point that breaks the end conditions or limits, a local "
+                                   "verdict rather than a proof that none meets them",
+    "Maximum_Iterations_Exceeded": "the solver did not converge within its iteration limit",
+    "Invalid_Number_Detected": "the model gave an invalid number (NaN) at a trial point",
+    "Restoration_Failed": "the solver could not get back to the end conditions and limits from a trial point",
+    "Error_In_Step_Computation": "the solver could not compute a step (a singular or ill-scaled problem)",
+    "Search_Direction_Becomes_Too_Small": "the solver stalled (its steps became too small)",
+    "Diverging_Iterates": "the solver's iterates diverged",
+    "User_Requested_Stop": "interrupted",
+}
+
+
+def solver_verdict(status):
+    """What the solver's ``status`` means, in words (for messages)."""
+    return SOLVER_VERDICTS.get(status, "the solver stopped without converging")
 
 
 def _slip_rate(model):

@@ -170,13 +170,15 @@ def check_pack(ocp):
     needed = abs(ocp.lock_torque) * (1 + ocp.lock_margin)
     if capacity >= needed:
         return
+    demand = (f"the locked driveline needs {abs(ocp.lock_torque):.4g} N m ({needed:.4g} N m with the "
+              f"{100 * ocp.lock_margin:g} % lock margin)")
     per_force = film.mu_static * film.area * film.r_eff * model.n_driving      # capacity per plate pressure [N m/Pa]
     how = (f"mu_s {film.mu_static:.3g}, {model.n_driving} interfaces, r_eff {film.r_eff * 1e3:.4g} mm")
     if by_contact:
         raise ModelError(
             f"scene '{name}': contact capacity: the asperities carry at most {contact / 1e6:.4g} MPa at a film of "
             f"{FILM_FLOOR:g} sigma (the model's edge is zero gap), a static capacity of {capacity:.4g} N m ({how}), "
-            f"below the {needed:.4g} N m the locked driveline needs: the clutch cannot hold at a positive film; "
+            f"below what {demand}: the clutch cannot hold at a positive film; "
             f"raise roughness.sigma_*, roughness.asperity_density or contact.E_equiv, or add plates.n_interfaces")
     want = needed / per_force                                           # plate pressure that would hold [Pa]
     if not model.has_piston:
@@ -189,7 +191,7 @@ def check_pack(ocp):
     fix = (f"raise actuation.max_pressure to at least {p_need / 1e6:.4g} MPa" if p_need is not None else
            "raise piston.spring_preload or piston.spring_stiffness (the springs apply this clutch)")
     raise ModelError(f"scene '{name}': pressure limit: at {ocp.apply_label()} the pack holds at most {capacity:.4g} N m "
-                     f"({how}), the locked driveline needs {needed:.4g} N m: no command locks this clutch; {fix} "
+                     f"({how}), {demand}: no command locks this clutch; {fix} "
                      f"or add plates.n_interfaces")
 
 

@@ -82,6 +82,7 @@ from .mesh import graded_mesh, interval_defects
 from .models import SceneModels
 from .objective import DEFAULT_WEIGHTS, OBJECTIVE_TERMS, SMOOTH_PER_JERK, check_weights  # noqa: F401 (public here)
 from .phases import Phase, PhasedNLP, phased_derivatives
+from .quiet import native_output_caught
 from .replay import simulate_command
 
 JUMP_MODES = ("constraint", "penalty")
@@ -765,14 +766,14 @@ class EngagementOCP:
         p = self.parameter_values(weights)
         solver = self.solver(warm)
         start = time.perf_counter()
-        with interrupt.in_solver():
+        with interrupt.in_solver(), native_output_caught() as native:
             sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p)
         wall = time.perf_counter() - start
         interrupt.check(f"IPOPT (scene '{self.scene.name}', t_max = {t_max:.4g} s)")
         st = solver.stats()
         stats = {"status": st["return_status"], "success": bool(st["success"]), "iterations": int(st["iter_count"]),
                  "wall_time_s": wall, "warm_start": bool(warm), "n_variables": int(w0.size),
-                 "n_constraints": int(lbg.size)}
+                 "n_constraints": int(lbg.size), "native_output": native[0] if native else ""}
         result = self._result(np.array(sol["x"]).ravel(), np.array(sol["lam_x"]).ravel(),
                               np.array(sol["lam_g"]).ravel(), float(sol["f"]), weights, stats)
         result.t_max, result.e_max = t_max, e_max

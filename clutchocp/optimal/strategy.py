@@ -24,7 +24,6 @@ scenes' optima are the ones of a single solve.
 import numpy as np
 
 from ..errors import ModelError, SolverError
-from .feasibility import lockup_energy_bound
 from .objective import check_weights
 
 RELAXED_JUMP_WEIGHT = 100.0       # weight of (jump / locked torque)^2 in the relaxed problem
@@ -123,10 +122,8 @@ def too_slow_message(ocp, t_max, t_star):
     limits = [f"a step to {ocp.apply_label()} locks up in {step:.4g} s but with a torque jump"]
     if ocp.heat_limits:
         limits.append("within the heat limits")
-    energy = lockup_energy_bound(ocp.model, t_max)
-    tail = f", dissipating at least {energy:.4g} J" if energy else ""
     return (f"scene '{ocp.scene.name}': t_max = {t_max:.4g} s is below the fastest lock-up that meets the end "
-            f"conditions (slipping torque = the locked torque, the lock holding{tail}): --t-max must be at least "
+            f"conditions (slipping torque = the locked torque, the lock holding): --t-max must be at least "
             f"{t_star:.4g} s for this clutch ({'; '.join(limits)}), or raise actuation.max_pressure")
 
 

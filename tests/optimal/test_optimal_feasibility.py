@@ -226,3 +226,17 @@ def test_solver_statuses_are_said_in_words():
                    "Something_New"):
         text = solver_verdict(status)
         assert "_" not in text and "ipopt" not in text.lower()
+
+
+def test_native_output_is_caught_not_printed(capfd):
+    """What C code writes to file descriptors 1 and 2 inside the block is handed over, not printed."""
+    import os
+    from clutchocp.optimal.quiet import native_output_caught
+    print("before", flush=True)
+    with native_output_caught() as caught:
+        os.write(1, b"native stdout\n")
+        os.write(2, b"CasADi - WARNING(NaN detected)\n")
+    print("after", flush=True)
+    out, err = capfd.readouterr()
+    assert out == "before\nafter\n" and err == ""
+    assert caught == ["native stdout\nCasADi - WARNING(NaN detected)"]

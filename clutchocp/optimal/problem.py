@@ -86,6 +86,7 @@ from .quiet import native_output_caught
 from .replay import simulate_command
 
 JUMP_MODES = ("constraint", "penalty")
+BARRIERS = ("adaptive", "monotone")         # IPOPT's mu_strategy: the default first
 SLIP_MODE = "pressing_slip_forward"
 FILL_MODE = "approach_slip_forward"
 
@@ -620,14 +621,17 @@ class EngagementOCP:
         return ca.Function("impact_link", [x_end, x_start], [x_start - self.impact_reset()(x_end)])
 
     # -- solving --------------------------------------------------------------------------------
-    def solver(self, warm=False):
-        """The IPOPT solver of the NLP (built once per kind, cold or warm start)."""
-        key = "warm" if warm else "cold"
+    def solver(self, warm=False, barrier=BARRIERS[0]):
+        """The IPOPT solver of the NLP (built once per kind: cold or warm start, barrier-parameter update
+        ``"adaptive"`` (default) or ``"monotone"``)."""
+        if barrier not in BARRIERS:
+            raise ModelError(f"barrier '{barrier}': allowed values are {', '.join(BARRIERS)}")
+        key = ("warm" if warm else "cold") + ("" if barrier == BARRIERS[0] else f"_{barrier}")
         if key not in self._solvers:
             if self._derivatives is None:
                 self._derivatives = phased_derivatives(self.phased)
             self._solvers[key] = nlp_solver(self.phased, warm=warm, name=f"engagement_{key}",
-                                            derivatives=self._derivatives)
+                                            derivatives=self._derivatives, ipopt={"mu_strategy": barrier})
         return self._solvers[key]
 
     @property
@@ -683,7 +687,7 @@ class EngagementOCP:
         twin._fastest = self._fastest
         return twin
 
-    def solve(self, *, t_max=None, e_max=None, weights=None, guess=None):
+    def solve(self, *, t_max=None, e_max=None, weights=None, guess=None, barrier=BARRIERS[0]):
         """Solve for the optimal command (and polish it on the exact model, see the class notes).
 
         Parameters
@@ -698,6 +702,10 @@ class EngagementOCP:
         guess : OptimalEngagement or EngagementResult, optional
             Start point: a previous optimum (warm start, with its multipliers if the mesh is the
             same) or a simulated run (default: the baseline run of the scene).
+        barrier : {"adaptive", "monotone"}
+            IPOPT's update of the barrier parameter in the first stage (the polish is a warm start
+            either way): adaptive (default) or monotone (Fiacco-McCormick), slower but steadier where
+            adaptive collapses the barrier early (see :mod:`clutchocp.optimal.strategy`).
 
         Returns
         -------
@@ -723,7 +731,7 @@ class EngagementOCP:
         check_heat(self, t_max, min(t_max, self.fastest_lockup()) if self.heat_limits else t_max)
         if e_max is not None and not (np.isfinite(e_max) and e_max > 0):
             raise ModelError(f"e_max = {e_max!r}: must be a positive energy [J]")
-        result = self._solve_stage(t_max, e_max, weights, guess)
+        result = self._solve_stage(t_max, e_max, weights, guess, barrier)
         stages = [dict(result.stats, model="smooth" if self.smooth else "exact")]
         if self.polish and result.success:
             polished = self.exact._solve_stage(t_max, e_max, weights, result)
@@ -739,8 +747,9 @@ class EngagementOCP:
             raise error
         return result
 
-    def _solve_stage(self, t_max, e_max, weights, guess):
+    def _solve_stage(self, t_max, e_max, weights, guess, barrier=None):
         """One IPOPT solve of this problem (no polish)."""
+        barrier = barrier or BARRIERS[0]
         nlp, sc = self.phased, self.scales
         warm = isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size \
             and guess.lam_g.size == nlp.lbg.size and self._same_meshes(guess)
@@ -764,7 +773,7 @@ class EngagementOCP:
         ubg[nlp.rows["total_time"]] = t_upper / sc.time_s
         ubg[nlp.end_rows(len(nlp.parts) - 1).stop - 1] = e_max / sc.energy_J if e_max is not None else np.inf
         p = self.parameter_values(weights)
-        solver = self.solver(warm)
+        solver = self.solver(warm, barrier)
         start = time.perf_counter()
         with interrupt.in_solver(), native_output_caught() as native:
             sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p)

@@ -199,6 +199,9 @@ class EngagementOCP:
     models : clutchocp.optimal.models.SceneModels, optional
         The engagement models of ``scene``, shared with other problems and replays of the same scene
         (its twins, the IDAS checks); default: new ones.
+    kiss_bound : bool
+        Fill phase of a spring-applied piston: keep the piston behind the kiss point (x0 <= travel).
+        :meth:`solve` sets it itself (solving again) where an optimum without it passes the kiss point.
     """
 
     # Scene values that are a parameter vector of the NLP functions (appended to the weights; the
@@ -210,7 +213,7 @@ class EngagementOCP:
     def __init__(self, scene, *, intervals=100, degree=3, scheme="radau", control="linear", rate_limit=None,
                  h_min=None, jump="constraint", lock_margin=0.005, smooth=True, polish=True,
                  transcription=None, baseline=None, fill_intervals=30, jerk_max=None, quasi_static_plates=None,
-                 max_temperature_C=None, max_specific_power_W_mm2=None, meshes=None, models=None):
+                 max_temperature_C=None, max_specific_power_W_mm2=None, meshes=None, models=None, kiss_bound=False):
         if jump not in JUMP_MODES:
             raise ModelError(f"jump '{jump}': allowed values are {', '.join(JUMP_MODES)}")
         if scene.kind != "engagement":
@@ -231,7 +234,9 @@ class EngagementOCP:
                         "rate_limit": rate_limit, "h_min": h_min, "jump": jump, "lock_margin": lock_margin,
                         "fill_intervals": fill_intervals, "jerk_max": jerk_max,
                         "quasi_static_plates": quasi_static_plates, "max_temperature_C": max_temperature_C,
-                        "max_specific_power_W_mm2": max_specific_power_W_mm2, "meshes": meshes}
+                        "max_specific_power_W_mm2": max_specific_power_W_mm2, "meshes": meshes,
+                        "kiss_bound": bool(kiss_bound)}
+        self.kiss_bound = bool(kiss_bound)
         self.jerk_max = jerk_max
         self.lock_margin = float(lock_margin)
         self.smooth = bool(smooth)
@@ -540,8 +545,20 @@ class EngagementOCP:
         nlp = PhasedNLP(phases, links)
         if len(phases) > 1 and self.spring_applied:
             self._bound_films_by_the_gap(nlp)
-            self._bound_piston_by_the_kiss(nlp)
+            if self.kiss_bound:
+                self._bound_piston_by_the_kiss(nlp)
         return nlp
+
+    def passes_kiss(self, opt):
+        """True if the fill phase of an optimum carries the piston past the kiss point (x0 > travel at a node
+        or collocation point before the phase's end; see :meth:`_bound_piston_by_the_kiss`)."""
+        if len(opt.phases) < 2:
+            return False
+        fill = opt.phases[0]
+        a, b = fill["nodes"]
+        reach = max(np.max(opt.states["x0"][a:b - 1]),
+                    np.max(opt.outputs_points["piston_position_m"][:fill["intervals"]].ravel()[:-1]))
+        return reach > self.model.travel * (1 + 1e-6)
 
     def _bound_piston_by_the_kiss(self, nlp):
         """Fill phase of a spring-applied piston: the piston not past the kiss point, x0 <= travel.
@@ -550,8 +567,11 @@ class EngagementOCP:
         kiss point and back, to end the phase at x0 = travel moving backwards; IDAS meets the kiss at
         the first crossing instead. Measured on the catalogue's helicopter_spring_applied_90C: a
         collocation kiss at 0.043 s at -0.083 m/s against IDAS's at 0.0099 s at +0.31 m/s, and IDAS
-        locking 2.6 % early with a jump of 15 % of the locked torque. The phase's end (node N and the
-        last Radau point, equal to it), where the end condition sets x0 = travel, is left free.
+        locking 2.6 % early with a jump of 15 % of the locked torque; with the bound, IDAS within
+        0.001 % and 0.5 %. The phase's end (node N and the last Radau point, equal to it), where the
+        end condition sets x0 = travel, is left free. Only where an optimum passes the kiss point
+        (``kiss_bound``, set by :meth:`solve`): on bao2020, whose optimum does not, the bound made the
+        solve on 100 intervals from the 60-interval optimum fail (a step IPOPT could not compute).
         """
         part, off = nlp.parts[0], int(nlp.offsets[0])
         n_x = part.problem.n_x
@@ -687,7 +707,7 @@ class EngagementOCP:
         twin._fastest = self._fastest
         return twin
 
-    def solve(self, *, t_max=None, e_max=None, weights=None, guess=None, barrier=BARRIERS[0]):
+    def solve(self, *, t_max=None, e_max=None, weights=None, guess=None, barrier=BARRIERS[0], warm_start=True):
         """Solve for the optimal command (and polish it on the exact model, see the class notes).
 
         Parameters
@@ -706,6 +726,9 @@ class EngagementOCP:
             IPOPT's update of the barrier parameter in the first stage (the polish is a warm start
             either way): adaptive (default) or monotone (Fiacco-McCormick), slower but steadier where
             adaptive collapses the barrier early (see :mod:`clutchocp.optimal.strategy`).
+        warm_start : bool
+            Start from an optimum ``guess`` with its multipliers where its NLP has this one's size
+            (default); False: from its states and command only.
 
         Returns
         -------
@@ -731,7 +754,7 @@ class EngagementOCP:
         check_heat(self, t_max, min(t_max, self.fastest_lockup()) if self.heat_limits else t_max)
         if e_max is not None and not (np.isfinite(e_max) and e_max > 0):
             raise ModelError(f"e_max = {e_max!r}: must be a positive energy [J]")
-        result = self._solve_stage(t_max, e_max, weights, guess, barrier)
+        result = self._solve_stage(t_max, e_max, weights, guess, barrier, warm_start)
         stages = [dict(result.stats, model="smooth" if self.smooth else "exact")]
         if self.polish and result.success:
             polished = self.exact._solve_stage(t_max, e_max, weights, result)
@@ -745,13 +768,32 @@ class EngagementOCP:
             error = SolverError(self._failure_message(result.stats, t_max))
             error.status = result.stats["status"]
             raise error
+        if not self.kiss_bound and self.spring_applied and self.passes_kiss(result):
+            # from now on bounded; again from this optimum's states and command (cold: its multipliers
+            # know no such bound)
+            self.bound_kiss()
+            return self.solve(t_max=t_max, e_max=e_max, weights=weights, guess=result, barrier=barrier,
+                              warm_start=False)
         return result
 
-    def _solve_stage(self, t_max, e_max, weights, guess, barrier=None):
+    def bound_kiss(self):
+        """Keep the piston behind the kiss point in the fill phase from now on (this problem, its exact twin
+        and the twins built from it; see :meth:`_bound_piston_by_the_kiss`)."""
+        if self.kiss_bound or len(self.phase_modes) < 2 or not self.spring_applied:
+            return
+        self.kiss_bound = True
+        self.options["kiss_bound"] = True
+        self._bound_piston_by_the_kiss(self.phased)
+        if self._exact is not None:
+            self._exact.bound_kiss()
+        if self._relaxed is not None:
+            self._relaxed.bound_kiss()
+
+    def _solve_stage(self, t_max, e_max, weights, guess, barrier=None, warm_start=True):
         """One IPOPT solve of this problem (no polish)."""
         barrier = barrier or BARRIERS[0]
         nlp, sc = self.phased, self.scales
-        warm = isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size \
+        warm = warm_start and isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size \
             and guess.lam_g.size == nlp.lbg.size and self._same_meshes(guess)
         if warm:
             w0, lam_x0, lam_g0 = guess.w.copy(), guess.lam_x, guess.lam_g

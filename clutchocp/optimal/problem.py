@@ -74,7 +74,7 @@ from ..errors import ModelError, SolverError
 from .bound import jerk_lower_bound, output_jerk_share
 from .collocation import DirectCollocation, StagedProblem
 from .derivatives import nlp_solver
-from .feasibility import (check_heat, check_pack, film_floor, hardest_command, holding_capacity,
+from .feasibility import (FILM_FLOOR, check_heat, check_pack, film_floor, hardest_command, holding_capacity,
                           locked_torque_at_lock, plate_force, spring_applied, usable_pressure)
 from .guess import guess_from_optimum, guess_from_run
 from .heat import heat_limits
@@ -775,6 +775,35 @@ class EngagementOCP:
             return self.solve(t_max=t_max, e_max=e_max, weights=weights, guess=result, barrier=barrier,
                               warm_start=False)
         return result
+
+    def floor_films(self):
+        """Keep every film above :data:`~clutchocp.optimal.feasibility.FILM_FLOOR` sigma from now on (this
+        problem, its exact and relaxed twins and the twins built from it).
+
+        The films' default lower bound is zero, the model's edge: IPOPT relaxes bounds by 1e-8, so a
+        trial point may sit at h = 0, where the third derivative of the Patir-Cheng shear factor
+        (H^2.31) in the jerk term's Hessian is infinite, a NaN. :func:`clutchocp.optimal.strategy.solve_robustly`
+        sets the floor after such a failure and before its minimum-time solve, which presses the films
+        hardest (measured on a user's 7-interface paper clutch: the minimum-time solve stopped on a NaN
+        without the floor).
+        """
+        floor = FILM_FLOOR * self.model.film.sigma
+        if (self.h_min or 0.0) >= floor:
+            return
+        self.h_min = floor
+        self.options["h_min"] = floor
+        for k, part in enumerate(self.phased.parts):
+            off, n_x = int(self.phased.offsets[k]), part.problem.n_x
+            (xs, (n_nodes, _)), (xcs, (N, d, _)) = part.layout["x"], part.layout["xc"]
+            for i, name in enumerate(self._names):
+                if name.startswith("h_"):
+                    value = floor / self.nominal[i]
+                    for start, count in ((xs, n_nodes), (xcs, N * d)):
+                        sl = slice(off + start + i, off + start + count * n_x, n_x)
+                        self.phased.lbx[sl] = np.maximum(self.phased.lbx[sl], value)
+        for twin in (self._exact, self._relaxed):
+            if twin is not None:
+                twin.floor_films()
 
     def bound_kiss(self):
         """Keep the piston behind the kiss point in the fill phase from now on (this problem, its exact twin

@@ -5,7 +5,9 @@ a clutch the scene's profile does not fit, that start can be far from any comman
 conditions (a profile that locks with a torque jump of three times the locked torque), and IPOPT
 ends at a local point of infeasibility or at its iteration limit. :func:`solve_robustly` then
 
-0. where IPOPT stalled (its iteration limit, a NaN, a failed step) rather than ending at a local
+0. after a NaN at a trial point (a film at the model's edge, h = 0) keeps the films above a floor
+   (:meth:`~clutchocp.optimal.problem.EngagementOCP.floor_films`), as it does before step 2;
+   where IPOPT stalled (its iteration limit, a NaN, a failed step) rather than ending at a local
    point of infeasibility, solves again from the same start with the monotone (Fiacco-McCormick)
    update of the barrier parameter, and uses it in the steps below. Measured on the catalogue's
    tractor_powershift_fill_60C (60 slip intervals): the adaptive update drove the barrier to 1e-11
@@ -92,6 +94,8 @@ def solve_robustly(ocp, *, t_max=None, weights=None, e_max=None, guess=None, say
     if opt is not None:
         return opt, t_max, info
     barrier = "adaptive"
+    if info["attempts"][-1]["status"] == "Invalid_Number_Detected":
+        ocp.floor_films()                 # a NaN at a trial point: a film at the model's edge
     if info["attempts"][-1]["status"] != "Infeasible_Problem_Detected":
         # not a verdict on the limits but a stall: the same start with the steadier barrier update
         barrier = "monotone"
@@ -110,6 +114,7 @@ def solve_robustly(ocp, *, t_max=None, weights=None, e_max=None, guess=None, say
         if opt is not None:
             return opt, t_max, info
     say("  finding the fastest lock-up that meets the end conditions (minimum time)")
+    ocp.floor_films()                     # the fastest lock-up presses the films hardest
     fastest = attempt("fastest lock-up (minimum time)", ocp, t_max=np.inf, weights=FASTEST_WEIGHTS,
                       guess=relaxed if relaxed is not None else guess, barrier=barrier)
     if fastest is None:

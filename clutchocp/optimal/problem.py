@@ -42,7 +42,15 @@ lock_margin x the peak torque of the reference run (transversal: the slip still 
 it has no holding condition (a lock that carries nothing always holds). With the output held the jerk
 term is the jerk of the input (the braked inertia), as the output does not move.
 
-Constraints: t_f <= t_max, E <= E_max, films h >= h_min, 0 <= u <= actuation.max_pressure,
+Before any run the scene is checked for what no command can do (:mod:`clutchocp.optimal.feasibility`:
+the pack's capacity at the pressure limit and at the contact's film floor against the locked torque,
+the kiss point; in :meth:`EngagementOCP.solve` t_max and the heat limits); a refusal is one line with
+both numbers. :func:`clutchocp.optimal.strategy.solve_robustly` wraps :meth:`EngagementOCP.solve` for
+clutches whose first solve does not converge.
+
+Constraints: t_f <= t_max, E <= E_max, films h >= h_min (at least
+:data:`~clutchocp.optimal.feasibility.FILM_FLOOR` sigma where the contact cannot carry the largest plate
+pressure at that film), 0 <= u <= actuation.max_pressure,
 |du/dt| <= rate limit, w_rel >= 0; with a spring-applied piston, films h <= their gap at the kiss
 in the slip phase (the piston not behind the kiss point, Bao Eq. 13); optionally interface temperature <= max_temperature_C (a scene
 with [thermal]) and interface heat per friction area <= max_specific_power_W_mm2 (path constraints,
@@ -174,7 +182,8 @@ class EngagementOCP:
     rate_limit : float, optional
         Largest command rate [Pa/s] (default: the pressure limit per 10 ms; ``numpy.inf``: none).
     h_min : float, optional
-        Smallest film thickness allowed [m] (default: none).
+        Smallest film thickness allowed [m] (default: none, or the film floor where the contact cannot
+        carry the largest plate pressure above it; see :func:`~clutchocp.optimal.feasibility.film_floor`).
     jump : {"constraint", "penalty"}
         Lock-up torque jump fixed by an end condition, or only the ``jump`` objective term.
     lock_margin : float
@@ -272,9 +281,9 @@ class EngagementOCP:
         # any run (:mod:`clutchocp.optimal.feasibility`).
         self.lock_torque = locked_torque_at_lock(self.model)
         check_pack(self)
-        # Films stay above a floor where the contact cannot carry the largest plate pressure at zero
-        # gap: at h = 0 the contact law ends (the model's edge) and the Patir-Cheng shear factor's
-        # third derivative (H^2.31) is infinite there, a NaN in the Hessian of the jerk term.
+        # Films stay above a floor where the contact cannot carry the largest plate pressure there
+        # (feasibility.film_floor): at h = 0 the contact law ends (the model's edge) and the
+        # Patir-Cheng shear factor's third derivative (H^2.31) is infinite, a NaN in the jerk Hessian.
         floor = film_floor(self.model.film, plate_force(self.model, hardest_command(self.model, self.p_max))
                            / self.model.film.area)
         self.h_min = max(h_min or 0.0, floor) or h_min

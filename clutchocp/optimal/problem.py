@@ -355,7 +355,7 @@ class EngagementOCP:
         summary = self.reference_run.summary
         t_ref = summary["engagement_time_s"]
         w_rel0, rate0 = self.initial_slip(model)
-        locked0 = self.lock_torque
+        locked0 = locked_torque_at_lock(model)       # at the lock-up speed (a load rising with speed)
         jerk_ref = jerk_lower_bound(w_rel0, rate0, t_ref) * max(self.output_jerk_share, 1e-3) ** 2
         peak = summary["peak_torque_Nm"]
         # A lock that carries (almost) no torque: the jump is the slipping torque before it, measured

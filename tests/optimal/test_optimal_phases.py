@@ -204,9 +204,10 @@ def test_brake_locks_as_the_input_comes_to_rest(tmp_path):
 @pytest.mark.slow
 def test_brake_on_the_lining_rough_pair_verifies():
     """zhang2021 as it stands, at 1.2 MPa (twice its pressure limit: the stop takes 4.97 s, the fastest 3.6 s).
-    On 100 equal intervals (50 ms, the pressure rise at the start unresolved) IDAS stops 0.35 % late, after the
-    holding command has started, with a step of 13 % of the peak torque; one mesh graded from the interval
-    defects passes (measured: 0.001 % and 0.78 %)."""
+    On 100 equal intervals (50 ms, the pressure rise at the start unresolved) IDAS stops 1.3 % late, after the
+    holding command has started, with a step of 5.8 % of the peak torque (the last command held to 1 % past
+    t_f, then the holding pressure); one mesh graded from the interval defects passes (measured: 0.001 % and
+    0.78 %)."""
     from clutchocp.optimal.mesh import solve_verified
     scene = load_scene("zhang2021", {"actuation.max_pressure": "1.2 MPa"})
     solved = solve_verified(EngagementOCP(scene, intervals=100, degree=3))

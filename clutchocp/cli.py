@@ -212,9 +212,9 @@ def _add_optimize(sub):
                    help="largest interface temperature [degC] while slipping (scene needs a [thermal] part)")
     p.add_argument("--max-specific-power", type=positive_float, default=None, metavar="W_MM2",
                    help="largest interface heat power per friction area [W/mm^2] while slipping")
-    p.add_argument("--clamp-margin", type=positive_float, default=1.3, metavar="RATIO",
+    p.add_argument("--clamp-margin", type=positive_float, default=None, metavar="RATIO",
                    help="after lock-up, ramp to the clamp pressure whose static torque capacity is RATIO x "
-                        "the locked torque (>= 1, default: 1.3)")
+                        "the locked torque (>= 1, default: 1.3, or the most the pack holds if less)")
 
     p.set_defaults(run=_command("optimize"))
 

@@ -77,6 +77,21 @@ class PackPressure:
     at_zero_oil_Pa: float
 
 
+def zero_gap_pressure(film):
+    """Largest pressure the asperity contact carries at a positive film [Pa]: its value at zero gap.
+
+    The contact law's own pressure at h = 0 (Greenwood-Tripp: K' E' F_5/2(0), F_5/2(0) = 0.61663;
+    Zhang's variant: E (pi n beta sigma F_1(0))^2), or infinity without a contact law.
+
+    Parameters
+    ----------
+    film : clutchocp.engagement.films.FilmLaw
+    """
+    if film.contact_model == "none":
+        return float("inf")
+    return float(film.contact_force(0.0)) / film.area
+
+
 def contact_capacity(scene):
     """The contact's capacity at zero gap (:class:`ContactCapacity`), or None for ``contact.model = "none"``
     (and for a scene that is not an engagement: its run refuses it).
@@ -90,7 +105,7 @@ def contact_capacity(scene):
     if model not in _LAWS:
         return None
     film = FilmLaw(scene)
-    pressure = float(film.contact_force(0.0)) / film.area
+    pressure = zero_gap_pressure(film)
     n_beta_sigma = film.n_a * film.beta * film.sigma
     law = _LAWS[model]
     if model == "greenwood_tripp" and film.fit == "patir":

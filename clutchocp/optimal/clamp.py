@@ -28,6 +28,8 @@ from scipy import optimize
 
 from ..engagement.model import EngagementModel
 from ..errors import ModelError
+from ..engagement.edges import zero_gap_pressure
+from .feasibility import hardest_command, lock_state, plate_force, spring_applied, usable_pressure
 
 DEFAULT_MARGIN = 1.3
 LOCKED_MODE = "pressing_locked"
@@ -101,11 +103,7 @@ class ClampModel:
         if model.actuation.has_state:            # settled valve: its pressure is the command
             x = ca.substitute(x, model.state("p_valve"), u)
         rates = ca.vertcat(*[mode.ode[i] for i in self.films])
-        self.x_lock = model.initial_state.copy()
-        w_lock = scene.value("driveline.output_speed")       # both sides at the output speed
-        for name in ("w_in", "w_out"):
-            if name in model.index:
-                self.x_lock[model.index[name]] = w_lock
+        self.x_lock = lock_state(model)                     # both sides at the lock-up speed
         self.piston = model.has_piston
         if self.piston:
             # the piston at rest: with v0 = 0 the film rates of equal films vanish for any thickness,
@@ -143,8 +141,11 @@ class ClampModel:
 
         lo, hi = 1e-3 * model.sigma, H0
         if first(lo) * first(hi) > 0:
-            raise ModelError(f"clamp pressure: no settled film thickness in [{lo:.3g}, {hi:.3g}] m at "
-                             f"{pressure / 1e6:.4g} MPa")
+            contact = zero_gap_pressure(model.film)
+            raise ModelError(f"clamp pressure: {pressure / 1e6:.4g} MPa presses the pack with "
+                             f"{plate_force(model, pressure) / model.film.area / 1e6:.4g} MPa, which no film between "
+                             f"{lo:.3g} and {hi:.3g} m carries (the contact carries at most {contact / 1e6:.4g} MPa "
+                             "at zero gap)")
         h0 = optimize.brentq(first, lo, hi, xtol=1e-15, rtol=1e-13)
         sol = optimize.least_squares(residual, np.full(len(self.films), h0), x_scale=model.sigma, xtol=1e-15,
                                      ftol=1e-15, gtol=1e-15)
@@ -155,6 +156,27 @@ class ClampModel:
         x = self.x_lock.copy()
         x[self.films] = self.settled_films(pressure)
         return float(np.array(self._fn(x, pressure)).ravel()[self.n_rates])
+
+    def pressure_range(self):
+        """Commands that press the settled pack [Pa], from the one that presses it least to the one that
+        presses it hardest: a pressure-applied piston from just above its kiss pressure (without a piston
+        from 1e-6 of the limit) to the limit; a spring-applied one from just below the pressure that
+        releases it down to zero. Either end is capped where the contact could not carry the pack's
+        pressure at a positive film (:func:`~clutchocp.optimal.feasibility.usable_pressure`)."""
+        model, p_max = self.model, self.p_max
+        hardest = usable_pressure(model, p_max)
+        F0, slope = plate_force(model, 0.0), plate_force(model, 1.0) - plate_force(model, 0.0)
+        if spring_applied(model):
+            return min(0.99 * (-F0 / slope), p_max), hardest        # slope < 0: the pressure releases the pack
+        least = 1e-6 * p_max
+        if self.piston and self.model.travel > 0:     # below the kiss pressure the piston does not press the pack
+            least = max(least, 1.01 * (-F0 / slope))
+        return least, hardest
+
+    def largest_margin(self, locked_torque=None):
+        """Settled static capacity at the command that presses the pack hardest over the locked torque [-]."""
+        demand = abs(self.locked_torque() if locked_torque is None else float(locked_torque))
+        return self.capacity(self.pressure_range()[1]) / demand
 
     def clamp_pressure(self, margin=DEFAULT_MARGIN, locked_torque=None):
         """Command pressure [Pa] whose settled capacity is ``margin`` x the locked torque.
@@ -167,22 +189,26 @@ class ClampModel:
         margin = check_margin(margin)
         demand = abs(self.locked_torque() if locked_torque is None else float(locked_torque))
         target = margin * demand
-        p_hi = self.p_max
-        if p_hi is None:
+        if self.p_max is None:
             raise ModelError("actuation.max_pressure: the clamp pressure needs an upper pressure limit")
-        top = self.capacity(p_hi)
+        least, hardest = self.pressure_range()
+        top = self.capacity(hardest)
         if top < target:
-            raise ModelError(f"clamp margin {margin:g}: the pressure limit {p_hi / 1e6:.4g} MPa gives a capacity of "
-                             f"{top:.4g} N m, {top / demand:.3g} x the locked torque {demand:.4g} N m; "
-                             "lower the margin or raise actuation.max_pressure")
-        p_lo = 1e-6 * p_hi
-        scene = self.model.scene
-        if self.piston and scene.variant("piston") != "spring_applied":
-            # below the kiss pressure (return spring at the pack) the piston does not press the pack
-            k = scene.value("piston.spring_stiffness") * scene.value("piston.spring_count")
-            kiss = k * (scene.value("piston.spring_preload") + self.model.travel) / scene.value("piston.area")
-            p_lo = max(p_lo, 1.01 * kiss)
-        return optimize.brentq(lambda p: self.capacity(p) - target, p_lo, p_hi, xtol=1e-6, rtol=1e-12)
+            if hardest != hardest_command(self.model, self.p_max):
+                why, fix = ("the most the contact carries at a positive film", "raise roughness.sigma_*, "
+                            "roughness.asperity_density or contact.E_equiv")
+            elif spring_applied(self.model):
+                why, fix = "zero pressure, the springs alone", "raise piston.spring_preload"
+            else:
+                why, fix = "the pressure limit", "raise actuation.max_pressure"
+            raise ModelError(f"clamp margin {margin:g}: the pack's static capacity at {hardest / 1e6:.4g} MPa ({why}) "
+                             f"is {top:.4g} N m, {top / demand:.4g} x the locked torque {demand:.4g} N m; "
+                             f"--clamp-margin must be at most {np.floor(top / demand * 1000) / 1000:.3f} for this "
+                             f"clutch, or {fix}")
+        if self.capacity(least) >= target:
+            return least
+        return optimize.brentq(lambda p: self.capacity(p) - target, min(least, hardest), max(least, hardest),
+                               xtol=1e-6, rtol=1e-12)
 
 
 def extend_to_clamp(scene, command_times, command, t_lock, *, margin=DEFAULT_MARGIN, rate_limit=None,

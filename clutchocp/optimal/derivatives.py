@@ -67,7 +67,10 @@ def nlp_solver(tr, *, warm=False, name="ocp", derivatives=None, ipopt=None):
     options = dict(IPOPT_OPTIONS, **(WARM_OPTIONS if warm else {}), **(ipopt or {}))
     derivatives = derivatives or structured_derivatives(tr)
     # the iteration callback stops IPOPT at the next iteration after a Ctrl-C (clutchocp.interrupt)
+    # show_eval_warnings: a NaN at a trial point is IPOPT's to handle (it backtracks); CasADi's own warning
+    # line about it is not the user's business
     return ca.nlpsol(name, "ipopt", tr.nlp, {"print_time": False, "ipopt": options, "error_on_fail": False,
+                                             "show_eval_warnings": False,
                                              "iteration_callback": interrupt.ipopt_callback(), **derivatives})
 
 

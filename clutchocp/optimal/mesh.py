@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import SolverError
 from .objective import OBJECTIVE_TERMS
+from .strategy import solve_robustly
 from .verify import verify
 
 ORDER_OVER_DEGREE = 1           # q = degree + 1
@@ -151,19 +152,27 @@ def solve_verified(ocp, *, refinements=MAX_REFINEMENTS, command_model=None, say=
     say = say or (lambda *a, **k: None)
     history = []
     coarse = None
+    adapt = solve_kwargs.get("t_max") is None          # a default t_max may be raised (strategy module)
+    strategy = {}
     if len(ocp.phase_modes) > 1 and solve_kwargs.get("guess") is None:
         coarse_ocp = ocp.coarsened(COARSE_FRACTION)
         say(f"  phased problem: solving on {coarse_ocp.transcription.intervals} slip intervals first")
-        coarse = coarse_ocp.solve(**solve_kwargs)
+        coarse, t_max, strategy["coarse start"] = solve_robustly(coarse_ocp, say=say, adapt_t_max=adapt,
+                                                                 **solve_kwargs)
+        solve_kwargs = dict(solve_kwargs, t_max=t_max, guess=coarse)
         history.append(_entry(coarse_ocp, coarse, None, stage="coarse start"))
-    opt = ocp.solve(**dict(solve_kwargs, guess=coarse) if coarse is not None else solve_kwargs)
+    opt, t_max, strategy["solve"] = solve_robustly(ocp, say=say, adapt_t_max=adapt, **solve_kwargs)
+    solve_kwargs = dict(solve_kwargs, t_max=t_max)
+    if "coarse start" in strategy and strategy["solve"]["t_max_source"] == "given":
+        strategy["solve"]["t_max_source"] = strategy["coarse start"]["t_max_source"]
     stage = "solve"
     while True:
         check, replay = verify(ocp.exact if ocp.polish else ocp, opt, model=command_model)
         history.append(_entry(ocp, opt, check, stage))
         stage = "graded mesh"
         if check["passed"] or sum(h["stage"] == "graded mesh" for h in history) >= refinements:
-            return {"ocp": ocp, "optimum": opt, "check": check, "replay": replay, "history": history}
+            return {"ocp": ocp, "optimum": opt, "check": check, "replay": replay, "history": history,
+                    "strategy": strategy}
         say(f"  IDAS replay off (lock-up {_pct(check['lock_time_rel_diff'])} from the collocation's, jump "
             f"{_pct(check['torque_jump_rel'])}): grading the mesh from the interval defects and solving again")
         refined = ocp.refined(opt)
@@ -172,7 +181,8 @@ def solve_verified(ocp, *, refinements=MAX_REFINEMENTS, command_model=None, say=
         except SolverError as exc:         # keep the last optimum; its check says it missed
             say(f"  the solve on the graded mesh failed ({exc}); keeping the previous optimum")
             history.append({"stage": "graded mesh", "graded": True, "failed": str(exc)})
-            return {"ocp": ocp, "optimum": opt, "check": check, "replay": replay, "history": history}
+            return {"ocp": ocp, "optimum": opt, "check": check, "replay": replay, "history": history,
+                    "strategy": strategy}
         ocp, opt = refined, opt_new
 
 

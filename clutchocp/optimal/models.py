@@ -66,7 +66,10 @@ class SceneModels:
         return self._replays[control]
 
     def clamp(self):
-        """The :class:`~clutchocp.optimal.clamp.ClampModel` of the scene (a massless pack)."""
+        """The :class:`~clutchocp.optimal.clamp.ClampModel` of the scene; with plate masses, of the scene
+        with a massless pack (a settled pack has its plates at rest: the same films and capacity)."""
         if self._clamp is None:
-            self._clamp = ClampModel(self.scene, *self.commanded())
+            masses = self.scene.variant("pack") == "masses"
+            scene = quasi_static_scene(self.scene) if masses else self.scene
+            self._clamp = ClampModel(scene, *self.commanded(quasi_static_plates=masses))
         return self._clamp

@@ -42,7 +42,15 @@ lock_margin x the peak torque of the reference run (transversal: the slip still 
 it has no holding condition (a lock that carries nothing always holds). With the output held the jerk
 term is the jerk of the input (the braked inertia), as the output does not move.
 
-Constraints: t_f <= t_max, E <= E_max, films h >= h_min, 0 <= u <= actuation.max_pressure,
+Before any run the scene is checked for what no command can do (:mod:`clutchocp.optimal.feasibility`:
+the pack's capacity at the pressure limit and at the contact's film floor against the locked torque,
+the kiss point; in :meth:`EngagementOCP.solve` t_max and the heat limits); a refusal is one line with
+both numbers. :func:`clutchocp.optimal.strategy.solve_robustly` wraps :meth:`EngagementOCP.solve` for
+clutches whose first solve does not converge.
+
+Constraints: t_f <= t_max, E <= E_max, films h >= h_min (at least
+:data:`~clutchocp.optimal.feasibility.FILM_FLOOR` sigma where the contact cannot carry the largest plate
+pressure at that film), 0 <= u <= actuation.max_pressure,
 |du/dt| <= rate limit, w_rel >= 0; behind a piston each film opens no faster than its Reynolds film
 would at 3 x film.cavitation_pressure (the film law itself holds its mean pressure at that pressure, see
 :meth:`EngagementOCP._cavitation_rows`); with a spring-applied piston, films h <= their gap at the kiss
@@ -76,18 +84,22 @@ from ..errors import ModelError, SolverError
 from .bound import jerk_lower_bound, output_jerk_share
 from .collocation import DirectCollocation, StagedProblem
 from .derivatives import MUMPS_UNSCALED, nlp_solver
+from .feasibility import (FILM_FLOOR, check_heat, check_pack, film_floor, hardest_command, holding_capacity,
+                          locked_torque_at_lock, plate_force, spring_applied, usable_pressure)
 from .guess import guess_from_optimum, guess_from_run
 from .heat import heat_limits
 from .mesh import graded_mesh, interval_defects
 from .models import SceneModels
 from .objective import DEFAULT_WEIGHTS, OBJECTIVE_TERMS, SMOOTH_PER_JERK, check_weights  # noqa: F401 (public here)
 from .phases import Phase, PhasedNLP, phased_derivatives
+from .quiet import native_output_caught
 from .replay import simulate_command
 
 JUMP_MODES = ("constraint", "penalty")
 # A film may open (cavitated) no faster than its averaged Reynolds film would at this multiple of the
 # cavitation pressure (see EngagementOCP._cavitation_rows)
 CAVITATION_DEPTH = 3.0
+BARRIERS = ("adaptive", "monotone")         # IPOPT's mu_strategy: the default first
 SLIP_MODE = "pressing_slip_forward"
 FILL_MODE = "approach_slip_forward"
 
@@ -175,7 +187,8 @@ class EngagementOCP:
     rate_limit : float, optional
         Largest command rate [Pa/s] (default: the pressure limit per 10 ms; ``numpy.inf``: none).
     h_min : float, optional
-        Smallest film thickness allowed [m] (default: none).
+        Smallest film thickness allowed [m] (default: none, or the film floor where the contact cannot
+        carry the largest plate pressure above it; see :func:`~clutchocp.optimal.feasibility.film_floor`).
     jump : {"constraint", "penalty"}
         Lock-up torque jump fixed by an end condition, or only the ``jump`` objective term.
     lock_margin : float
@@ -200,6 +213,9 @@ class EngagementOCP:
     models : clutchocp.optimal.models.SceneModels, optional
         The engagement models of ``scene``, shared with other problems and replays of the same scene
         (its twins, the IDAS checks); default: new ones.
+    kiss_bound : bool
+        Fill phase of a spring-applied piston: keep the piston behind the kiss point (x0 <= travel).
+        :meth:`solve` sets it itself (solving again) where an optimum without it passes the kiss point.
     """
 
     # Scene values that are a parameter vector of the NLP functions (appended to the weights; the
@@ -211,7 +227,7 @@ class EngagementOCP:
     def __init__(self, scene, *, intervals=100, degree=3, scheme="radau", control="linear", rate_limit=None,
                  h_min=None, jump="constraint", lock_margin=0.005, smooth=True, polish=True,
                  transcription=None, baseline=None, fill_intervals=30, jerk_max=None, quasi_static_plates=None,
-                 max_temperature_C=None, max_specific_power_W_mm2=None, meshes=None, models=None):
+                 max_temperature_C=None, max_specific_power_W_mm2=None, meshes=None, models=None, kiss_bound=False):
         if jump not in JUMP_MODES:
             raise ModelError(f"jump '{jump}': allowed values are {', '.join(JUMP_MODES)}")
         if scene.kind != "engagement":
@@ -232,7 +248,9 @@ class EngagementOCP:
                         "rate_limit": rate_limit, "h_min": h_min, "jump": jump, "lock_margin": lock_margin,
                         "fill_intervals": fill_intervals, "jerk_max": jerk_max,
                         "quasi_static_plates": quasi_static_plates, "max_temperature_C": max_temperature_C,
-                        "max_specific_power_W_mm2": max_specific_power_W_mm2, "meshes": meshes}
+                        "max_specific_power_W_mm2": max_specific_power_W_mm2, "meshes": meshes,
+                        "kiss_bound": bool(kiss_bound)}
+        self.kiss_bound = bool(kiss_bound)
         self.jerk_max = jerk_max
         self.lock_margin = float(lock_margin)
         self.smooth = bool(smooth)
@@ -263,6 +281,17 @@ class EngagementOCP:
             if start_mode == FILL_MODE else None
         # Output held (a brake): the braked side is the input; its jerk is the one felt.
         self.output_held = not self.model.output_inertia and self.model.input_inertia
+        # The torque the locked driveline carries, at the lock-up speed (a load that rises with speed
+        # carries more there than at the start), and what the pack can hold against it: checked before
+        # any run (:mod:`clutchocp.optimal.feasibility`).
+        self.lock_torque = locked_torque_at_lock(self.model)
+        check_pack(self)
+        # Films stay above a floor where the contact cannot carry the largest plate pressure there
+        # (feasibility.film_floor): at h = 0 the contact law ends (the model's edge) and the
+        # Patir-Cheng shear factor's third derivative (H^2.31) is infinite, a NaN in the jerk Hessian.
+        floor = film_floor(self.model.film, plate_force(self.model, hardest_command(self.model, self.p_max))
+                           / self.model.film.area)
+        self.h_min = max(h_min or 0.0, floor) or h_min
         self.baseline = baseline if baseline is not None else simulate_engagement(scene)
         self._fastest = None
         # The run that seeds the first solve and sets the scales: the baseline if it locks up.
@@ -271,7 +300,6 @@ class EngagementOCP:
         self.rate_limit = self.p_max / 0.01 if rate_limit is None else float(rate_limit)
         if not self.rate_limit > 0:
             raise ModelError(f"rate_limit = {rate_limit!r}: must be a positive rate [Pa/s]")
-        self.h_min = h_min
         self.output_jerk_share = 1.0 if self.output_held else output_jerk_share(scene)
         self.has_valve = self.model.actuation.has_state
         self.state_groups = self._state_groups(self.model)
@@ -288,6 +316,7 @@ class EngagementOCP:
         self.nlp = self.phased.parts[0] if len(self.phased.parts) == 1 else self.phased
         self._solvers = {}
         self._derivatives = None
+        self._relaxed = None
 
     # -- set-up ---------------------------------------------------------------------------------
     def _state_groups(self, model):
@@ -331,7 +360,7 @@ class EngagementOCP:
         summary = self.reference_run.summary
         t_ref = summary["engagement_time_s"]
         w_rel0, rate0 = self.initial_slip(model)
-        locked0 = float(ca.Function("locked", [model.x], [model.locked_torque()])(model.initial_state))
+        locked0 = locked_torque_at_lock(model)       # at the lock-up speed (a load rising with speed)
         jerk_ref = jerk_lower_bound(w_rel0, rate0, t_ref) * max(self.output_jerk_share, 1e-3) ** 2
         peak = summary["peak_torque_Nm"]
         # A lock that carries (almost) no torque: the jump is the slipping torque before it, measured
@@ -526,7 +555,7 @@ class EngagementOCP:
             # with the pressure and let it go, a 20 m/s kiss. A pressure-applied piston gets no bound:
             # its optimum does not move back, and an inactive bound (at 1 or 10 % of the stroke)
             # made IPOPT take 262 or 111 iterations instead of 47 on default_fill.
-            if self.apply_pressure == 0.0:
+            if self.spring_applied:
                 i_x0 = self._names.index("x0")
                 x_lb[i_x0] = -0.1 * self.model.travel / self.nominal[i_x0]
             end_lb, end_ub = np.zeros(1), np.zeros(1)
@@ -561,9 +590,43 @@ class EngagementOCP:
             phases.append(Phase(name, mode, self.staged_problem(name), tr))
         links = [self.impact_link()] if len(phases) > 1 else []
         nlp = PhasedNLP(phases, links)
-        if len(phases) > 1 and self.apply_pressure == 0.0:
+        if len(phases) > 1 and self.spring_applied:
             self._bound_films_by_the_gap(nlp)
+            if self.kiss_bound:
+                self._bound_piston_by_the_kiss(nlp)
         return nlp
+
+    def passes_kiss(self, opt):
+        """True if the fill phase of an optimum carries the piston past the kiss point (x0 > travel at a node
+        or collocation point before the phase's end; see :meth:`_bound_piston_by_the_kiss`)."""
+        if len(opt.phases) < 2:
+            return False
+        fill = opt.phases[0]
+        a, b = fill["nodes"]
+        reach = max(np.max(opt.states["x0"][a:b - 1]),
+                    np.max(opt.outputs_points["piston_position_m"][:fill["intervals"]].ravel()[:-1]))
+        return reach > self.model.travel * (1 + 1e-6)
+
+    def _bound_piston_by_the_kiss(self, nlp):
+        """Fill phase of a spring-applied piston: the piston not past the kiss point, x0 <= travel.
+
+        The fill mode has no plates, so without this bound its optimum may carry the piston past the
+        kiss point and back, to end the phase at x0 = travel moving backwards; IDAS meets the kiss at
+        the first crossing instead. Measured on the catalogue's helicopter_spring_applied_90C: a
+        collocation kiss at 0.043 s at -0.083 m/s against IDAS's at 0.0099 s at +0.31 m/s, and IDAS
+        locking 2.6 % early with a jump of 15 % of the locked torque; with the bound, IDAS within
+        0.001 % and 0.5 %. The phase's end (node N and the last Radau point, equal to it), where the
+        end condition sets x0 = travel, is left free. Only where an optimum passes the kiss point
+        (``kiss_bound``, set by :meth:`solve`): on bao2020, whose optimum does not, the bound made the
+        solve on 100 intervals from the 60-interval optimum fail (a step IPOPT could not compute).
+        """
+        part, off = nlp.parts[0], int(nlp.offsets[0])
+        n_x = part.problem.n_x
+        (xs, (n_nodes, _)), (xcs, (N, d, _)) = part.layout["x"], part.layout["xc"]
+        i = self._names.index("x0")
+        kiss = self.model.travel / self.nominal[i]
+        nlp.ubx[off + xs + i:off + xs + (n_nodes - 1) * n_x:n_x] = kiss                  # nodes 0 ... N-1
+        nlp.ubx[off + xcs + i:off + xcs + (N * d - 1) * n_x:n_x] = kiss                  # all points but the last
 
     def _bound_films_by_the_gap(self, nlp):
         """Slip phase of a spring-applied piston: no film thicker than its gap at the kiss, H0.
@@ -625,15 +688,19 @@ class EngagementOCP:
         return ca.Function("impact_link", [x_end, x_start], [x_start - self.impact_reset()(x_end)])
 
     # -- solving --------------------------------------------------------------------------------
-    def solver(self, warm=False):
-        """The IPOPT solver of the NLP (built once per kind, cold or warm start)."""
-        key = "warm" if warm else "cold"
+    def solver(self, warm=False, barrier=BARRIERS[0]):
+        """The IPOPT solver of the NLP (built once per kind: cold or warm start, barrier-parameter update
+        ``"adaptive"`` (default) or ``"monotone"``)."""
+        if barrier not in BARRIERS:
+            raise ModelError(f"barrier '{barrier}': allowed values are {', '.join(BARRIERS)}")
+        key = ("warm" if warm else "cold") + ("" if barrier == BARRIERS[0] else f"_{barrier}")
         if key not in self._solvers:
             if self._derivatives is None:
                 self._derivatives = phased_derivatives(self.phased)
             self._solvers[key] = nlp_solver(self.phased, warm=warm, name=f"engagement_{key}",
                                             derivatives=self._derivatives,
-                                            ipopt=MUMPS_UNSCALED if self.model.thermal.present and not warm else None)
+                                            ipopt=dict(MUMPS_UNSCALED if self.model.thermal.present and not warm else {},
+                                                       mu_strategy=barrier))
         return self._solvers[key]
 
     @property
@@ -666,6 +733,19 @@ class EngagementOCP:
         twin._fastest = self._fastest
         return twin
 
+    def relaxed(self):
+        """The same problem (same meshes) with the lock-up jump as a penalty instead of an end condition,
+        built once: the start of :func:`clutchocp.optimal.strategy.solve_robustly` where this one fails."""
+        if self._relaxed is None:
+            tr = self.transcription
+            meshes = {name: part.transcription.mesh for (name, _), part in zip(self.phase_modes, self.phased.parts)}
+            options = dict(self.options, jump="penalty", meshes=meshes, intervals=tr.intervals, degree=tr.degree,
+                           scheme=tr.scheme, control=tr.control)
+            self._relaxed = EngagementOCP(self.scene, smooth=self.smooth, polish=False, baseline=self.baseline,
+                                          models=self.models, **options)
+            self._relaxed._fastest = self._fastest
+        return self._relaxed
+
     def with_meshes(self, meshes):
         """The same problem on other meshes (``{phase name: interval shares}``); the baseline is shared."""
         tr = self.transcription
@@ -676,7 +756,7 @@ class EngagementOCP:
         twin._fastest = self._fastest
         return twin
 
-    def solve(self, *, t_max=None, e_max=None, weights=None, guess=None):
+    def solve(self, *, t_max=None, e_max=None, weights=None, guess=None, barrier=BARRIERS[0], warm_start=True):
         """Solve for the optimal command (and polish it on the exact model, see the class notes).
 
         Parameters
@@ -691,6 +771,13 @@ class EngagementOCP:
         guess : OptimalEngagement or EngagementResult, optional
             Start point: a previous optimum (warm start, with its multipliers if the mesh is the
             same) or a simulated run (default: the baseline run of the scene).
+        barrier : {"adaptive", "monotone"}
+            IPOPT's update of the barrier parameter in the first stage (the polish is a warm start
+            either way): adaptive (default) or monotone (Fiacco-McCormick), slower but steadier where
+            adaptive collapses the barrier early (see :mod:`clutchocp.optimal.strategy`).
+        warm_start : bool
+            Start from an optimum ``guess`` with its multipliers where its NLP has this one's size
+            (default); False: from its states and command only.
 
         Returns
         -------
@@ -713,9 +800,10 @@ class EngagementOCP:
         if not (t_max > 0):
             raise ModelError(f"t_max = {t_max!r}: must be a positive time [s]")
         self.check_feasible_time(t_max)
+        check_heat(self, t_max, min(t_max, self.fastest_lockup()) if self.heat_limits else t_max)
         if e_max is not None and not (np.isfinite(e_max) and e_max > 0):
             raise ModelError(f"e_max = {e_max!r}: must be a positive energy [J]")
-        result = self._solve_stage(t_max, e_max, weights, guess)
+        result = self._solve_stage(t_max, e_max, weights, guess, barrier, warm_start)
         stages = [dict(result.stats, model="smooth" if self.smooth else "exact")]
         if self.polish and result.success:
             polished = self.exact._solve_stage(t_max, e_max, weights, result)
@@ -726,13 +814,64 @@ class EngagementOCP:
                             warm_start=stages[0]["warm_start"], iterations=sum(s["iterations"] for s in stages),
                             wall_time_s=sum(s["wall_time_s"] for s in stages), stages=stages)
         if not result.success:
-            raise SolverError(self._failure_message(result.stats, t_max))
+            error = SolverError(self._failure_message(result.stats, t_max))
+            error.status = result.stats["status"]
+            raise error
+        if not self.kiss_bound and self.spring_applied and self.passes_kiss(result):
+            # from now on bounded; again from this optimum's states and command (cold: its multipliers
+            # know no such bound)
+            self.bound_kiss()
+            return self.solve(t_max=t_max, e_max=e_max, weights=weights, guess=result, barrier=barrier,
+                              warm_start=False)
         return result
 
-    def _solve_stage(self, t_max, e_max, weights, guess):
+    def floor_films(self):
+        """Keep every film above :data:`~clutchocp.optimal.feasibility.FILM_FLOOR` sigma from now on (this
+        problem, its exact and relaxed twins and the twins built from it).
+
+        The films' default lower bound is zero, the model's edge: IPOPT relaxes bounds by 1e-8, so a
+        trial point may sit at h = 0, where the third derivative of the Patir-Cheng shear factor
+        (H^2.31) in the jerk term's Hessian is infinite, a NaN. :func:`clutchocp.optimal.strategy.solve_robustly`
+        sets the floor after such a failure and before its minimum-time solve, which presses the films
+        hardest (measured on a user's 7-interface paper clutch: the minimum-time solve stopped on a NaN
+        without the floor).
+        """
+        floor = FILM_FLOOR * self.model.film.sigma
+        if (self.h_min or 0.0) >= floor:
+            return
+        self.h_min = floor
+        self.options["h_min"] = floor
+        for k, part in enumerate(self.phased.parts):
+            off, n_x = int(self.phased.offsets[k]), part.problem.n_x
+            (xs, (n_nodes, _)), (xcs, (N, d, _)) = part.layout["x"], part.layout["xc"]
+            for i, name in enumerate(self._names):
+                if name.startswith("h_"):
+                    value = floor / self.nominal[i]
+                    for start, count in ((xs, n_nodes), (xcs, N * d)):
+                        sl = slice(off + start + i, off + start + count * n_x, n_x)
+                        self.phased.lbx[sl] = np.maximum(self.phased.lbx[sl], value)
+        for twin in (self._exact, self._relaxed):
+            if twin is not None:
+                twin.floor_films()
+
+    def bound_kiss(self):
+        """Keep the piston behind the kiss point in the fill phase from now on (this problem, its exact twin
+        and the twins built from it; see :meth:`_bound_piston_by_the_kiss`)."""
+        if self.kiss_bound or len(self.phase_modes) < 2 or not self.spring_applied:
+            return
+        self.kiss_bound = True
+        self.options["kiss_bound"] = True
+        self._bound_piston_by_the_kiss(self.phased)
+        if self._exact is not None:
+            self._exact.bound_kiss()
+        if self._relaxed is not None:
+            self._relaxed.bound_kiss()
+
+    def _solve_stage(self, t_max, e_max, weights, guess, barrier=None, warm_start=True):
         """One IPOPT solve of this problem (no polish)."""
+        barrier = barrier or BARRIERS[0]
         nlp, sc = self.phased, self.scales
-        warm = isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size \
+        warm = warm_start and isinstance(guess, OptimalEngagement) and guess.w.size == nlp.lbx.size \
             and guess.lam_g.size == nlp.lbg.size and self._same_meshes(guess)
         if warm:
             w0, lam_x0, lam_g0 = guess.w.copy(), guess.lam_x, guess.lam_g
@@ -754,16 +893,16 @@ class EngagementOCP:
         ubg[nlp.rows["total_time"]] = t_upper / sc.time_s
         ubg[nlp.end_rows(len(nlp.parts) - 1).stop - 1] = e_max / sc.energy_J if e_max is not None else np.inf
         p = self.parameter_values(weights)
-        solver = self.solver(warm)
+        solver = self.solver(warm, barrier)
         start = time.perf_counter()
-        with interrupt.in_solver():
+        with interrupt.in_solver(), native_output_caught() as native:
             sol = solver(x0=w0, lam_x0=lam_x0, lam_g0=lam_g0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=p)
         wall = time.perf_counter() - start
         interrupt.check(f"IPOPT (scene '{self.scene.name}', t_max = {t_max:.4g} s)")
         st = solver.stats()
         stats = {"status": st["return_status"], "success": bool(st["success"]), "iterations": int(st["iter_count"]),
                  "wall_time_s": wall, "warm_start": bool(warm), "n_variables": int(w0.size),
-                 "n_constraints": int(lbg.size)}
+                 "n_constraints": int(lbg.size), "native_output": native[0] if native else ""}
         result = self._result(np.array(sol["x"]).ravel(), np.array(sol["lam_x"]).ravel(),
                               np.array(sol["lam_g"]).ravel(), float(sol["f"]), weights, stats)
         result.t_max, result.e_max = t_max, e_max
@@ -783,18 +922,11 @@ class EngagementOCP:
                                                     for a, b in zip(opt.meshes, mine))
 
     def _failure_message(self, stats, t_max):
+        """One line for a solve that ended without an optimum: what the solver's status means for the user."""
         status = stats["status"]
         where = (f"scene '{self.scene.name}', t_max = {t_max:.4g} s, {self.transcription.intervals} intervals, "
                  f"{stats['iterations']} iterations")
-        if status == "Infeasible_Problem_Detected":
-            hint = (f"no command within the pressure and rate limits locks up by t_max with the end conditions "
-                    f"(the fastest lock-up, a step to {self._apply_label()}, takes {self.fastest_lockup():.4g} s); "
-                    f"raise t_max, e_max or the limits")
-        elif status == "Maximum_Iterations_Exceeded":
-            hint = "start from a nearby solution (warm start) or use fewer intervals"
-        else:
-            hint = "try another t_max, more intervals or other weights"
-        return f"optimal engagement: IPOPT stopped with {status} ({where}); {hint}"
+        return f"optimal engagement: no optimum found ({where}): {solver_verdict(status)}"
 
     def _result(self, w, lam_x, lam_g, objective, weights, stats):
         sc = self.scales
@@ -917,6 +1049,16 @@ class EngagementOCP:
             return 1.5 * self.fastest_lockup()
         return t_lock
 
+    def default_t_max_source(self):
+        """Where :meth:`default_t_max` comes from, in words (for progress lines and summary.json)."""
+        t_lock = self.baseline.summary["engagement_time_s"]
+        if t_lock is None:
+            return f"1.5 x the fastest lock-up (a step to {self.apply_label()}): the scene's own profile does not lock up"
+        if t_lock <= 1.001 * self.fastest_lockup():
+            return (f"1.5 x the fastest lock-up (a step to {self.apply_label()}): the scene's own profile locks up "
+                    f"no later than that")
+        return "the lock-up time of the scene's own profile"
+
     def fastest_run(self):
         """IDAS run of a step of the command to the pressure that applies the clutch hardest (cached):
         the pressure limit, or zero for a spring-applied piston (the pressure releases it)."""
@@ -924,20 +1066,36 @@ class EngagementOCP:
             t_end = self.scene.value("simulation.t_end")
             run = simulate_command(self.scene, [0.0], [self.apply_pressure], t_end, model=self.models.replay())
             if run.summary["engagement_time_s"] is None:
-                raise ModelError(f"scene '{self.scene.name}': even a step to {self._apply_label()} does not lock "
-                                 f"up within simulation.t_end = {t_end:g} s; raise the pressure limit or t_end")
+                capacity = holding_capacity(self.model, self.apply_pressure)[0]
+                raise ModelError(f"scene '{self.scene.name}': even a step to {self.apply_label()} does not lock up "
+                                 f"within simulation.t_end = {t_end:g} s (the pack holds {capacity:.4g} N m there, "
+                                 f"the locked driveline needs {abs(self.lock_torque):.4g} N m); raise simulation.t_end "
+                                 f"(--set simulation.t_end=...) or actuation.max_pressure")
             self._fastest = run
         return self._fastest
 
     @property
-    def apply_pressure(self):
-        """Command that applies the clutch hardest [Pa]: 0 for a spring-applied piston, else the limit."""
-        spring_applied = self.model.has_piston and self.scene.variant("piston") == "spring_applied"
-        return 0.0 if spring_applied else self.p_max
+    def spring_applied(self):
+        """True for a spring-applied piston (the pressure releases the clutch)."""
+        return spring_applied(self.model)
 
-    def _apply_label(self):
-        return "zero pressure (spring-applied)" if self.apply_pressure == 0.0 else \
-            f"actuation.max_pressure = {self.p_max / 1e6:.3g} MPa"
+    @property
+    def apply_pressure(self):
+        """Command that applies the clutch hardest [Pa]: 0 for a spring-applied piston, else the limit;
+        where the contact cannot carry that at zero gap, the command whose settled plate pressure is the
+        contact's at the film floor (:func:`~clutchocp.optimal.feasibility.usable_pressure`)."""
+        return usable_pressure(self.model, self.p_max)
+
+    def apply_label(self):
+        """The command that applies the clutch hardest, in words (for messages)."""
+        p = self.apply_pressure
+        if self.spring_applied:
+            return "zero pressure (spring-applied)" if p == 0.0 else \
+                f"{p / 1e6:.4g} MPa (spring-applied; the contact carries no more at a positive film)"
+        if p < self.p_max:
+            return (f"{p / 1e6:.4g} MPa (the most the contact carries at a positive film; actuation.max_pressure "
+                    f"= {self.p_max / 1e6:.4g} MPa)")
+        return f"actuation.max_pressure = {self.p_max / 1e6:.4g} MPa"
 
     def fastest_lockup(self):
         """Lock-up time [s] of a step to :attr:`apply_pressure` (no command within the limits locks sooner)."""
@@ -952,9 +1110,28 @@ class EngagementOCP:
             return
         fastest = self.fastest_lockup()
         if t_max < fastest:
-            raise ModelError(f"t_max = {t_max:.4g} s is below the fastest lock-up the pressure limit allows "
-                             f"({fastest:.4g} s with a step to {self._apply_label()}); "
-                             f"raise t_max or the pressure limit")
+            raise ModelError(f"scene '{self.scene.name}': t_max = {t_max:.4g} s is below the fastest lock-up the "
+                             f"pressure limit allows: --t-max must be at least {fastest:.4g} s for this clutch (a step "
+                             f"to {self.apply_label()} locks up then), or raise actuation.max_pressure")
+
+
+# What an IPOPT status means for the user (its own words stay out of the messages).
+SOLVER_VERDICTS = {
+    "Infeasible_Problem_Detected": "the solver ended at a point that breaks the end conditions or limits, a local "
+                                   "verdict rather than a proof that none meets them",
+    "Maximum_Iterations_Exceeded": "the solver did not converge within its iteration limit",
+    "Invalid_Number_Detected": "the model gave an invalid number (NaN) at a trial point",
+    "Restoration_Failed": "the solver could not get back to the end conditions and limits from a trial point",
+    "Error_In_Step_Computation": "the solver could not compute a step (a singular or ill-scaled problem)",
+    "Search_Direction_Becomes_Too_Small": "the solver stalled (its steps became too small)",
+    "Diverging_Iterates": "the solver's iterates diverged",
+    "User_Requested_Stop": "interrupted",
+}
+
+
+def solver_verdict(status):
+    """What the solver's ``status`` means, in words (for messages)."""
+    return SOLVER_VERDICTS.get(status, "the solver stopped without converging")
 
 
 def _slip_rate(model):

@@ -12,6 +12,7 @@ import numpy as np
 from ..engagement.model import EngagementModel
 from ..engagement.run import EngagementResult, summarize
 from ..errors import ModelError
+from .quiet import native_output_caught
 from ..simulation import (
     Event,
     HybridModel,
@@ -136,6 +137,8 @@ def simulate_command(scene, times, values, t_end, *, hold=None, model=None, cont
     grid = np.unique(grid[(grid >= 0) & (grid <= t_end)])
     x0 = dict(zip(eng.state_names, eng.initial_state))
     start = time.perf_counter()
-    result = simulate(model.hybrid, x0, grid, mode=eng.initial_mode(), u=model.inputs(times, values, hold), options=options)
+    with native_output_caught():         # SUNDIALS' own warning lines: the run's result or error speaks for it
+        result = simulate(model.hybrid, x0, grid, mode=eng.initial_mode(), u=model.inputs(times, values, hold),
+                          options=options)
     wall = time.perf_counter() - start
     return EngagementResult(eng, result, summarize(eng, result, wall, options, "idas"))

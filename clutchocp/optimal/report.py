@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..engagement.report import plot_heat, write_timeseries
-from ..errors import ClutchocpError
+from ..errors import ClutchocpError, SolverError
 from ..output import shown, write_csv, write_summary, writes_folder
 from ..scene import default_scene, load_scene
 from .baselines import baseline_label, simulate_baselines, tune_fill_pulse
@@ -37,7 +37,7 @@ CLAMP_SETTLE_S = 0.3       # the whole-curve replay runs this long after the cla
 @writes_folder
 def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, intervals=100, degree=3,
                  sweep_t_max=None, progress=True, max_temperature_C=None, max_specific_power_W_mm2=None,
-                 clamp_margin=DEFAULT_MARGIN):
+                 clamp_margin=None):
     """Optimal engagement pressure of a scene: solve, verify with IDAS, compare, write files.
 
     Parameters
@@ -61,10 +61,12 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         Print progress lines (stages, sweep points) and the summary.
     max_temperature_C, max_specific_power_W_mm2 : float, optional
         Heat limits of the slip phase (see :mod:`clutchocp.optimal.heat`); adds ``heat`` to the summary.
-    clamp_margin : float
+    clamp_margin : float, optional
         Static torque capacity at the clamp pressure over the locked torque (>= 1): after lock-up
         the command ramps at the rate limit to that clamp pressure and holds it
-        (:mod:`clutchocp.optimal.clamp`); pressure_profile.csv holds the whole curve.
+        (:mod:`clutchocp.optimal.clamp`); pressure_profile.csv holds the whole curve. Default:
+        ``DEFAULT_MARGIN`` (1.3), or the largest margin the pack holds if that is less (a margin given
+        that the pack cannot hold is refused before solving).
 
     Returns
     -------
@@ -102,7 +104,7 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
 
 
 def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degree=3, sweep_t_max=None,
-                   progress=False, max_temperature_C=None, max_specific_power_W_mm2=None, clamp_margin=DEFAULT_MARGIN):
+                   progress=False, max_temperature_C=None, max_specific_power_W_mm2=None, clamp_margin=None):
     """Solve, verify with IDAS and compare with the baselines, without writing files.
 
     Parameters are those of :func:`run_optimize` (``scene`` may also be a name or a path).
@@ -114,7 +116,8 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
         the baseline runs; ``table()`` and ``plot()`` for a look.
     """
     say = print if progress else (lambda *a, **k: None)
-    clamp_margin = check_margin(clamp_margin)          # a bad margin fails before the solve
+    margin_given = clamp_margin is not None
+    clamp_margin = check_margin(clamp_margin if margin_given else DEFAULT_MARGIN)   # a bad margin fails before the solve
     if scene is None:
         scene = default_scene()
     elif isinstance(scene, (str, Path)):
@@ -124,17 +127,21 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
     ocp = EngagementOCP(scene, intervals=intervals, degree=degree, max_temperature_C=max_temperature_C,
                         max_specific_power_W_mm2=max_specific_power_W_mm2)
     build_time = time.perf_counter() - start
+    if ocp.holds_torque:          # the clamp after lock-up must be within reach before a solve is spent
+        clamp_margin = _reachable_margin(ocp, clamp_margin, margin_given, say)
     command_model = ocp.models.replay(ocp.transcription.control)
     solved = solve_verified(ocp, t_max=t_max, weights=weights, command_model=command_model, say=say)
     ocp, opt, check, replay = solved["ocp"], solved["optimum"], solved["check"], solved["replay"]
     graded = sum(h["stage"] == "graded mesh" and "failed" not in h for h in solved["history"])
-    say(f"  IPOPT {opt.stats['status']}: {opt.stats['iterations']} iterations, {opt.stats['wall_time_s']:.2f} s"
+    say(f"  optimum found: {opt.stats['iterations']} iterations, {opt.stats['wall_time_s']:.2f} s"
         + (f" (after {graded} mesh refinement(s))" if graded else ""))
     say(f"  IDAS re-simulation: lock-up {format_quantity(check['idas']['engagement_time_s'], 's')}, "
         f"jump {format_quantity(check['torque_jump_Nm'], 'N m')}")
     # the calibration shape "fill pulse, hold, ramp" is that of a pressure-applied piston
     fill = _fill_comparison(ocp, opt, check, command_model, intervals, degree, say) \
-        if len(opt.phases) > 1 and ocp.apply_pressure > 0 else None
+        if len(opt.phases) > 1 and not ocp.spring_applied else None
+    if fill is not None and "failed" in fill:
+        say(f"  fill-pulse comparison left out: {fill['failed']}")
     curve, whole = _clamp_curve(scene, ocp, opt, command_model, clamp_margin)
     say(f"  after lock-up: ramp to the clamp pressure {curve.clamp_pressure_Pa / 1e6:.4g} MPa by "
         f"{curve.ramp_end_s:.4g} s ({curve.basis}); lock held in the IDAS replay: {whole['lock_held']}")
@@ -160,7 +167,8 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
         "jerk_lower_bound_ratio": opt.terms["slip_jerk_integral"] / bound,
         "initial_slip_rad_s": w_rel0,
         "initial_slip_rate_rad_s2": rate0,
-        "limits": {"t_max_s": opt.t_max if np.isfinite(opt.t_max) else None, "e_max_J": opt.e_max,
+        "limits": {"t_max_s": opt.t_max if np.isfinite(opt.t_max) else None,
+                   "t_max_source": solved["strategy"]["solve"]["t_max_source"], "e_max_J": opt.e_max,
                    "max_pressure_Pa": ocp.p_max,
                    "rate_limit_Pa_s": ocp.rate_limit if np.isfinite(ocp.rate_limit) else None,
                    "lock_margin": ocp.lock_margin},
@@ -175,7 +183,8 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
                    "intervals": intervals, "degree": degree, "scheme": ocp.transcription.scheme,
                    "control": opt.control, "n_variables": opt.stats["n_variables"],
                    "stages": [{k: s[k] for k in ("model", "status", "iterations", "wall_time_s", "warm_start")}
-                              for s in opt.stats["stages"]]},
+                              for s in opt.stats["stages"]],
+                   "attempts": {name: how["attempts"] for name, how in solved["strategy"].items()}},
     }
     summary["heat"] = heat_check(ocp, opt, replay)
     if "fill_time_s" in opt.terms:
@@ -184,8 +193,26 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
         summary["sweep"] = sweep
     if fill is not None:
         summary["fill_comparison"] = fill["summary"]
+    if fill is not None and "failed" in fill:
+        fill = None
     return OptimizationResult(scene, summary, ocp, opt, replay, baselines, fill=fill, curve=curve,
                               clamp_run=whole["run"], figure=result_figure)
+
+
+def _reachable_margin(ocp, margin, given, say):
+    """The clamp margin to use: ``margin`` if the pack can hold it; a default one lowered to the most the
+    pack holds (said in a progress line); a given one refused (ModelError, with the largest it can be)."""
+    clamp = ocp.models.clamp()
+    if given:
+        clamp.clamp_pressure(margin)
+        return margin
+    largest = clamp.largest_margin()
+    if largest >= margin:
+        return margin
+    lowered = np.floor(largest * 1000) / 1000
+    say(f"  clamp: the pack holds at most {largest:.4g} x the locked torque; the clamp margin is {lowered:g} "
+        f"instead of {margin:g}")
+    return check_margin(lowered)
 
 
 def _lockup_definition(ocp):
@@ -219,7 +246,10 @@ def _fill_comparison(ocp, opt, check, command_model, intervals, degree, say):
     fast_ocp = EngagementOCP(ocp.scene, intervals=intervals, degree=degree, jerk_max=jerk_max, baseline=ocp.baseline,
                              models=ocp.models)
     say(f"  minimum-time optimum with |jerk| <= {jerk_max:.4g} rad/s^3")
-    fast = fast_ocp.solve(weights=FAST_WEIGHTS, guess=opt)
+    try:
+        fast = fast_ocp.solve(t_max=opt.t_max, weights=FAST_WEIGHTS, guess=opt)
+    except SolverError as exc:       # a comparison, not the optimum: the optimize result stands without it
+        return {"failed": str(exc), "summary": {"failed": str(exc)}, "baseline": tuned}
     fast_check, fast_run = verify(fast_ocp.exact, fast, model=command_model)
     numbers = fast_check["idas"]
     summary = {

@@ -1,0 +1,242 @@
+"""What no command can do, checked before solving (clutchocp.optimal.feasibility): each bound against an
+independent value (closed form, conservation law, IDAS run), and each refusal one line with its numbers."""
+
+import math
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from clutchocp.engagement.model import EngagementModel
+from clutchocp.engagement.run import simulate_engagement
+from clutchocp.errors import ModelError
+from clutchocp.optimal.clamp import ClampModel
+from clutchocp.optimal.feasibility import (
+    FILM_FLOOR,
+    holding_capacity,
+    lockup_energy_bound,
+    temperature_bound,
+    thermal_response,
+    usable_pressure,
+)
+from clutchocp.engagement.edges import zero_gap_pressure
+from clutchocp.optimal.problem import EngagementOCP, solver_verdict
+from clutchocp.scene import default_scene, load_scene
+
+CATALOGUE = Path(__file__).resolve().parents[2] / "models" / "catalogue"
+F52_AT_ZERO = 0.61663            # Greenwood-Tripp F_5/2(0)
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return default_scene()
+
+
+@pytest.fixture(scope="module")
+def model(scene):
+    return EngagementModel(scene, pressure_command=ca.SX.sym("u"))
+
+
+def test_zero_gap_pressure_is_greenwood_tripps_closed_form(scene, model):
+    n, beta, sigma = (scene.value(k) for k in ("roughness.asperity_density", "roughness.asperity_radius",
+                                               "roughness.sigma"))
+    closed = 16 * math.sqrt(2) / 15 * math.pi * (n * beta * sigma) ** 2 * math.sqrt(sigma / beta) \
+        * scene.value("contact.E_equiv") * F52_AT_ZERO
+    assert zero_gap_pressure(model.film) == pytest.approx(closed, rel=1e-4)
+    assert zero_gap_pressure(model.film) == pytest.approx(1.79e6, rel=3e-3)     # the catalogue's table
+
+
+def test_holding_capacity_is_the_settled_clamp_capacity(scene, model):
+    """Without a piston the plate force is p A at any film: the bound is the settled pack's capacity."""
+    p = scene.value("actuation.max_pressure")
+    capacity, plate, contact, by_contact = holding_capacity(model, p)
+    assert plate == pytest.approx(p) and not by_contact and contact > p
+    assert capacity == pytest.approx(ClampModel(scene).capacity(p), rel=1e-6)
+    # and the closed form mu_s p A r_eff n
+    film = model.film
+    assert capacity == pytest.approx(0.12 * p * film.area * film.r_eff * 4, rel=1e-12)
+
+
+def test_energy_identity_and_bound_on_an_idas_run(scene, model):
+    """E_slip = 1/2 I_eq w_rel0^2 + T_lock int w_rel dt (the identity the bound rests on), checked on the
+    scene's own IDAS run; and the bound 1/2 I_eq w_rel0^2 below what the run dissipates."""
+    run = simulate_engagement(scene)
+    res = run.result
+    t_lock = run.summary["engagement_time_s"]
+    lock = next(e for e in res.events if e.name == "lockup")
+    keep = (res.t <= t_lock) & (np.asarray(res.mode) == "pressing_slip_forward")
+    t, idx = np.unique(res.t[keep], return_index=True)
+    w_rel = (res["w_in_rad_s"] - res["w_out_rad_s"])[keep][idx]
+    I_in, I_out = 0.25, 2.0
+    I_eq = I_in * I_out / (I_in + I_out)
+    T_lock = I_eq * (150.0 / I_in + 100.0 / I_out)
+    identity = 0.5 * I_eq * 150.0**2 + T_lock * np.trapezoid(w_rel, t)
+    # E_slip + the residual slip's kinetic energy at the event (E_impact) is the slip energy
+    assert lock.x_before["E_slip"] + lock.x_after["E_impact"] == pytest.approx(identity, rel=2e-3)
+    bound = lockup_energy_bound(model, t_lock)
+    assert bound == pytest.approx(0.5 * I_eq * 150.0**2, rel=1e-12)
+    assert bound < run.summary["dissipated_energy_J"]
+
+
+def test_energy_bound_is_approached_by_a_hard_constant_torque_lock():
+    """A lock by a constant clutch torque T_c dissipates 1/2 I_eq w0^2 T_c / (T_c - T_lock) (closed form of
+    the linear slip decay), which tends to the bound as T_c grows and never falls below it."""
+    I_eq, w0, T_lock = 0.25 * 2 / 2.25, 150.0, 0.25 * 2 / 2.25 * (150 / 0.25 + 100 / 2)
+    for T_c in (200.0, 1e3, 1e5):
+        t_lock = w0 * I_eq / (T_c - T_lock)
+        energy = T_c * w0 * t_lock / 2                      # int T_c w_rel dt with w_rel linear
+        assert energy == pytest.approx(0.5 * I_eq * w0**2 * T_c / (T_c - T_lock), rel=1e-12)
+        assert energy >= 0.5 * I_eq * w0**2
+    assert energy == pytest.approx(0.5 * I_eq * w0**2, rel=2e-3)
+
+
+def test_thermal_responses_are_the_lumped_closed_forms():
+    """Impulse response a^2/C_s e^(-G t/C_s) + (1 - a)^2/C_f e^(-G t/C_f) and the free cooling of the
+    lumped plates (clutchocp.physics.thermal), from their equations by the matrix exponential."""
+    scene = load_scene("default_driveline_thermal").with_overrides({"thermal.initial_temperature_C": 70.0})
+    model = EngagementModel(scene, pressure_command=ca.SX.sym("u"))
+    free, impulse = thermal_response(model)
+    a, C_f, C_s = 0.961, 144.0, 142.0
+    G = 1000.0 * model.film.area * 4
+    for t in (0.0, 0.3, 5.0):
+        g = a**2 / C_s * math.exp(-G * t / C_s) + (1 - a) ** 2 / C_f * math.exp(-G * t / C_f)
+        assert impulse(t) == pytest.approx(g, rel=1e-9)
+        cool = a * (40 + 30 * math.exp(-G * t / C_s)) + (1 - a) * (40 + 30 * math.exp(-G * t / C_f))
+        assert free(t) == pytest.approx(cool, rel=1e-9)
+
+
+def test_temperature_bound_is_below_the_idas_peak():
+    scene = load_scene("default_driveline_thermal")
+    model = EngagementModel(scene, pressure_command=ca.SX.sym("u"))
+    run = simulate_engagement(scene)
+    t_lock = run.summary["engagement_time_s"]
+    bound = temperature_bound(model, lockup_energy_bound(model, t_lock), 0.5 * t_lock, t_lock)
+    peak = np.max(run.result["interface_temperature_C"][run.result.t <= t_lock])
+    assert 40.0 < bound < peak
+
+
+@pytest.mark.parametrize("name, words", [
+    ("infeasible_dct_overload_launch", ["pressure limit", "356 N m", "409.4 N m", "0.6 MPa",
+                                        "raise actuation.max_pressure to at least"]),
+    ("infeasible_fill_spring_over_limit", ["kiss point", "0.512 MPa", "0.45 MPa", "piston.spring_preload"]),
+    ("infeasible_paper_gw_contact", ["contact capacity", "zero gap", "N m", "roughness.sigma_*"]),
+])
+def test_infeasible_catalogue_clutches_are_refused_before_any_run(name, words):
+    """The three deliberately infeasible clutches: one line with the limit, both numbers and the field."""
+    with pytest.raises(ModelError) as info:
+        EngagementOCP(load_scene(CATALOGUE / f"{name}.toml"), intervals=5)
+    message = str(info.value)
+    assert "\n" not in message and all(w in message for w in words), message
+    assert "ipopt" not in message.lower() and "e_max" not in message
+
+
+def test_the_contact_caps_the_usable_pressure_and_the_films():
+    """sigma_1 = 6 um: Greenwood-Tripp carries 0.77 MPa at zero gap, below the 1.5 MPa limit. The step for
+    the fastest lock-up and the clamp stop at the contact's pressure at the film floor, and the films
+    may not go below that floor."""
+    scene = default_scene().with_overrides({"roughness.sigma_1": 6e-6})
+    model = EngagementModel(scene, pressure_command=ca.SX.sym("u"))
+    film = model.film
+    assert zero_gap_pressure(film) == pytest.approx(0.77e6, rel=0.01)
+    p = usable_pressure(model, 1.5e6)
+    assert p == pytest.approx(float(film.contact_force(FILM_FLOOR * film.sigma)) / film.area, rel=1e-12)
+    assert p < zero_gap_pressure(film)
+    clamp = ClampModel(scene)
+    least, hardest = clamp.pressure_range()
+    assert hardest == pytest.approx(p) and clamp.settled_films(hardest)[0] == pytest.approx(FILM_FLOOR * film.sigma,
+                                                                                              rel=1e-6)
+
+
+def test_a_clamp_margin_the_pack_cannot_hold_names_the_largest():
+    scene = default_scene().with_overrides({"roughness.sigma_1": 5e-6})
+    clamp = ClampModel(scene)
+    largest = clamp.largest_margin()
+    assert 1.0 < largest < 1.3
+    with pytest.raises(ModelError) as info:
+        clamp.clamp_pressure(1.3)
+    message = str(info.value)
+    assert "\n" not in message and f"--clamp-margin must be at most {math.floor(largest * 1000) / 1000:.3f}" in message
+    assert "contact" in message and "actuation.max_pressure" not in message
+
+
+def test_spring_applied_clamp_presses_with_less_pressure():
+    """A spring-applied brake: pressure releases it, so the clamp pressure sits below the release pressure
+    and its settled capacity is the margin times the locked torque."""
+    scene = load_scene(CATALOGUE / "winch_sahr_brake_gear_oil_50C.toml")
+    clamp = ClampModel(scene)
+    least, hardest = clamp.pressure_range()
+    assert hardest == 0.0 and least > 0.0
+    p = clamp.clamp_pressure(1.3)
+    assert 0.0 < p < least
+    assert clamp.capacity(p) == pytest.approx(1.3 * abs(clamp.locked_torque()), rel=1e-6)
+
+
+def test_clamp_of_a_pack_with_plate_masses_is_its_massless_twins():
+    from clutchocp.optimal.models import SceneModels, quasi_static_scene
+    scene = load_scene(CATALOGUE / "helicopter_spring_applied_masses_2face_60C.toml")
+    clamp = SceneModels(scene).clamp()
+    assert clamp.clamp_pressure(1.3) == pytest.approx(ClampModel(quasi_static_scene(scene)).clamp_pressure(1.3))
+
+
+def test_a_prescribed_input_with_a_rising_load_locks_carrying_its_load_at_the_input_speed():
+    """tractor PTO: the load rises with speed squared; at the start (output at rest) it is zero, at lock-up
+    it is the rated 900 N m. The problem must know the lock carries torque."""
+    scene = load_scene(CATALOGUE / "tractor_pto_clutch_60C.toml")
+    ocp = EngagementOCP(scene, intervals=5)
+    assert ocp.lock_torque == pytest.approx(900.0, rel=1e-3) and ocp.holds_torque
+
+
+def test_temperature_limit_below_what_the_lockup_energy_gives_is_refused():
+    ocp = EngagementOCP(load_scene("default_driveline_thermal"), intervals=5, max_temperature_C=45.0)
+    with pytest.raises(ModelError) as info:
+        ocp.solve()
+    message = str(info.value)
+    assert "\n" not in message and "--max-temperature must be at least" in message and "45 degC" in message
+    least = float(message.split("--max-temperature must be at least ")[1].split(" degC")[0])
+    assert 45.0 < least < 82.1                     # the optimum at the default limits peaks at 82.1 degC
+
+
+def test_specific_power_limit_below_what_the_lockup_energy_needs_is_refused(scene):
+    """0.15 W/mm^2 is above the open pack's drag at t = 0 (0.0995 W/mm^2) but 2500 J over 39 320 mm^2
+    take 0.42 s at that rate: no lock-up by 0.3 s."""
+    ocp = EngagementOCP(scene, intervals=5, max_specific_power_W_mm2=0.15)
+    with pytest.raises(ModelError) as info:
+        ocp.solve(t_max=0.3)
+    message = str(info.value)
+    area = 4 * ocp.model.film.area * 1e6
+    need = 0.5 * (0.25 * 2 / 2.25) * 150**2 / (area * 0.3)
+    assert "\n" not in message and f"--max-specific-power must be at least {need:.4g} W/mm^2" in message
+    assert "--t-max at least" in message
+
+
+def test_specific_power_limit_below_the_open_packs_drag_is_refused(scene):
+    """The open pack's drag at t = 0 (viscous torque at the initial gap times the slip) over the friction area."""
+    ocp = EngagementOCP(scene, intervals=5, max_specific_power_W_mm2=0.05)
+    with pytest.raises(ModelError) as info:
+        ocp.solve(t_max=0.3)
+    message = str(info.value)
+    run = simulate_engagement(scene)
+    drag = run.result["interface_heat_power_W"][0] / (4 * ocp.model.film.area * 1e6)
+    assert "\n" not in message and f"--max-specific-power must be at least {drag:.4g} W/mm^2" in message
+
+
+def test_solver_statuses_are_said_in_words():
+    for status in ("Infeasible_Problem_Detected", "Maximum_Iterations_Exceeded", "Invalid_Number_Detected",
+                   "Something_New"):
+        text = solver_verdict(status)
+        assert "_" not in text and "ipopt" not in text.lower()
+
+
+def test_native_output_is_caught_not_printed(capfd):
+    """What C code writes to file descriptors 1 and 2 inside the block is handed over, not printed."""
+    import os
+    from clutchocp.optimal.quiet import native_output_caught
+    print("before", flush=True)
+    with native_output_caught() as caught:
+        os.write(1, b"native stdout\n")
+        os.write(2, b"CasADi - WARNING(NaN detected)\n")
+    print("after", flush=True)
+    out, err = capfd.readouterr()
+    assert out == "before\nafter\n" and err == ""
+    assert caught == ["native stdout\nCasADi - WARNING(NaN detected)"]

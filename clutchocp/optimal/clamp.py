@@ -26,9 +26,9 @@ import casadi as ca
 import numpy as np
 from scipy import optimize
 
+from ..engagement.edges import zero_gap_pressure
 from ..engagement.model import EngagementModel
 from ..errors import ModelError
-from ..engagement.edges import zero_gap_pressure
 from .feasibility import hardest_command, lock_state, plate_force, spring_applied, usable_pressure
 
 DEFAULT_MARGIN = 1.3

@@ -16,7 +16,9 @@ def test_builtin_spec_loads_with_units():
     assert spec.anti_windup == "clamping" and spec.progress == "time"
     assert spec.lqi["slip_tolerance"] == pytest.approx(0.03)
     assert spec.t_max_fraction == pytest.approx(0.98)
-    assert spec.estimator == {"enabled": True, "activation": 0.5, "gain_limit": 1.5}
+    assert {k: spec.estimator[k] for k in ("enabled", "method", "activation", "gain_limit")} == \
+        {"enabled": True, "method": "difference", "activation": 0.5, "gain_limit": 1.5}
+    assert spec.sensors == {} and spec.valve == {"dead_time": 0.0, "assumed_dead_time": 0.0}
     assert (spec.schedule_field, spec.schedule_points) == ("oil.viscosity", 5)
     bare = parse_slip_spec(GOOD)            # without the tables: no estimator, no schedule
     assert not bare.estimator["enabled"] and bare.schedule_field == "" and bare.schedule_points == 1

@@ -144,15 +144,24 @@ def _pressure_reference(sensors, t, p):
 
 def _tcu_lqr(w, model, w_rel0, t_lock, p_range):
     """LQR gains (N, n + 1) on [xi; z] (Bryson's rule on slip, slip rate, integral and correction, as the
-    difference design's :func:`~clutchocp.shiftcontrol.design._slip_lqr`)."""
+    difference design's :func:`~clutchocp.shiftcontrol.design._slip_lqr`).
+
+    With ``correction_rate_tolerance`` the input is the change of the correction, v = du - du_prev (du_prev is
+    a state of the TCU): the weight on v smooths the correction from sample to sample, and
+    ``correction_tolerance`` weighs du itself; the gains returned act on the correction, du = -K [xi; z].
+    """
     N, n = model.A.shape[0], model.A.shape[1]
     e_s, r_s, xi_s = abs(w_rel0), abs(w_rel0) / t_lock, abs(w_rel0) * t_lock
+    j = model.names.index("du_prev")
+    rate = w.get("correction_rate_tolerance")
 
     def weight(slip_row, rate_row):
         Q = np.zeros((n + 1, n + 1))
         Q[:n, :n] = (np.outer(slip_row, slip_row) / (w["slip_tolerance"] * e_s) ** 2
                      + np.outer(rate_row, rate_row) / (w["slip_rate_tolerance"] * r_s) ** 2)
         Q[n, n] = 1.0 / (w["integral_tolerance"] * xi_s) ** 2
+        if rate:
+            Q[j, j] = 1.0 / (w["correction_tolerance"] * p_range) ** 2
         return Q
 
     A, B, Q = [], [], []
@@ -160,9 +169,16 @@ def _tcu_lqr(w, model, w_rel0, t_lock, p_range):
         Ak = np.eye(n + 1)
         Ak[:n, :n] = model.A[k]
         Ak[n, :n] = model.durations[k] * model.slip_row[k]
+        Bk = np.append(model.B[k], 0.0)[:, None]
+        if rate:                      # du = du_prev + v
+            Ak[:, j] += Bk[:, 0]
         A.append(Ak)
-        B.append(np.append(model.B[k], 0.0)[:, None])
+        B.append(Bk)
         Q.append(weight(model.slip_row[k], model.slip_rate_row[k]))
-    R = [np.array([[1.0 / (w["correction_tolerance"] * p_range) ** 2]])] * N
+    tolerance = rate if rate else w["correction_tolerance"]
+    R = [np.array([[1.0 / (tolerance * p_range) ** 2]])] * N
     K, _ = tvlqr(A, B, Q, R, w["terminal_weight"] * weight(model.slip_row_end, model.slip_rate_end))
-    return K[:, 0, :]
+    K = K[:, 0, :]
+    if rate:                          # v = -K_v [xi; z]: du = du_prev + v = -(K_v - e_du_prev) [xi; z]
+        K[:, j] -= 1.0
+    return K

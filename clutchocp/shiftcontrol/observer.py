@@ -7,8 +7,8 @@ engine torque, valve lag ...; theta_i = theta_i,nom (1 + d_i)). The TCU's state 
 
     xi = [dx (the model's physical states), s (pressure-sensor reading, with a sensor lag),
           a_in, a_out (the shafts' angles turned since the last sample, for a tooth wheel),
-          d (estimated parameters), b (pressure-sensor offset), du_prev (the previous correction,
-          with a valve dead time)]
+          d (estimated parameters), b (pressure-sensor offset), du_prev (the previous correction:
+          it still acts over the valve dead time, and the LQR weighs the change of the correction)]
 
 and one sample [t_k, t_k+1] maps it exactly for the frozen-midpoint pieces (matrix exponentials of
 [[A_c, B_c, F_c], [0, 0, 0]] over sub-intervals, A_c with the sensor lag ds/dt = (dp - ds) / lag):
@@ -16,8 +16,14 @@ the correction du_k reaches the valve after the dead time D the TCU assumes, so 
 [t_k, t_k + D] and du_k over [t_k + D, t_k+1] (the sample map is split there). The parameters, the
 offset are constant. The TCU measures y = (w_in, w_out [, the pressure reading s + b] [, the
 engine-torque signal T_in,nom (1 + d_Tin)]); a tooth wheel gives the mean speed over the last
-sample, a / Ts (da/dt = dw, a set to zero at every sample: its column of A_k is zero), an ideal
-sensor the speed at t_k.
+sample, a / Ts + (e_k - e_k-1) / Ts (da/dt = dw, a set to zero at every sample: its column of A_k is
+zero; e_k the angle error at the edge that ends window k and starts window k + 1: the tooth's
+cumulative pitch error and the timer's, white from sample to sample, carried as the states ``edge:``
+and ``edge_prev:`` so that the anticorrelation of consecutive readings is the filter's), an ideal
+sensor the speed at t_k. The window of edge timing ends at the last edge, on average half a tooth
+period before t_k: the reference reading is the nominal mean speed over the window shifted so, and
+the spread of that age (uniform over a tooth period) times the nominal acceleration is white reading
+noise.
 
 Noise (the Kalman filter's covariances): readings from the sensor models' variances at the nominal
 speeds (:meth:`~clutchocp.shiftcontrol.sensors.SpeedSensor.variance`), the pressure sensor's
@@ -151,11 +157,13 @@ class TCUModelBuilder:
         self.averaged = tuple(name for name in ("w_in", "w_out") if speed_sensors[name].averages)
         names += [f"mean:{name}" for name in self.averaged]
         self.n_c = self.n + (1 if self.lag > 0 else 0) + len(self.averaged)       # states with dynamics
+        self.speed_sensors = speed_sensors
+        for name in self.averaged:
+            names += [f"edge:{name}", f"edge_prev:{name}"]
         names += [f"d:{name}" for name in lin.parameter_names]
         if self.offset > 0:
             names.append("p_offset")
-        if self.dead_time > 0:
-            names.append("du_prev")
+        names.append("du_prev")              # the correction applied at the last sample
         self.names = tuple(names)
         measured = ["w_in", "w_out"] + (["p_sensor"] if self.has_p else [])
         self.torque_channel = (sensors.engine_torque.source == "plant"
@@ -209,7 +217,7 @@ class TCUModelBuilder:
         A, B, C = np.zeros((N, n_a, n_a)), np.zeros((N, n_a)), np.zeros((N, p, n_a))
         slip, rate, y_ref = np.zeros((N, n_a)), np.zeros((N, n_a)), np.zeros((N, p))
         durations = np.minimum(np.asarray(sample_times) + Ts, t_lock) - np.asarray(sample_times)
-        params = slice(n_c, n_c + self.m)
+        params = [self.index(f"d:{name}") for name in self.lin.parameter_names]
         sig = {name: j for j, name in enumerate(self.lin.signals)}
         for k, start in enumerate(sample_times):
             end = start + durations[k]
@@ -227,11 +235,14 @@ class TCUModelBuilder:
             A[k][:n_c, params] = Psi
             for name in self.averaged:            # the angle counts from zero again at every sample
                 A[k][:, self.index(f"mean:{name}")] = 0.0
-            if self.dead_time > 0:
-                j = self.index("du_prev")
-                A[k][:n_c, j] = G_prev[:, 0]
-                A[k][j, j] = 0.0
-                B[k][j] = 1.0
+                edge, previous = self.index(f"edge:{name}"), self.index(f"edge_prev:{name}")
+                A[k][edge, edge] = 0.0                # a new boundary error each sample (process noise)
+                A[k][previous, previous] = 0.0
+                A[k][previous, edge] = 1.0
+            j = self.index("du_prev")
+            A[k][:n_c, j] = G_prev[:, 0]          # zero without a dead time
+            A[k][j, j] = 0.0
+            B[k][j] = 1.0
             B[k][:n_c] = G_cur[:, 0]
             _, _, _, Cs, Gs = self._continuous(start)
             slip[k, :self.n] = Cs[sig["w_rel"]]
@@ -242,8 +253,8 @@ class TCUModelBuilder:
         slip_end, rate_end = np.zeros(n_a), np.zeros(n_a)
         slip_end[:self.n], rate_end[:self.n] = end_state[3][sig["w_rel"]], end_state[3][sig["slip_rate"]]
         rate_end[params] = end_state[4][sig["slip_rate"]]
-        Q = np.array([self._process_noise(Ts) for _ in range(N)])
-        R = np.array([self._reading_noise(y_ref[k], Ts) for k in range(N)])
+        Q = np.array([self._process_noise(Ts, t) for t in sample_times])
+        R = np.array([self._reading_noise(y_ref[k], Ts, t) for k, t in enumerate(sample_times)])
         return TCUModel(self.names, self.measured, A, B, C, y_ref, slip, rate, slip_end, rate_end, durations, Q, R,
                         self._prior(y_ref[0], Ts))
 
@@ -255,9 +266,12 @@ class TCUModelBuilder:
         rows, values = [], []
         for name in self.measured:
             row = np.zeros(n_a)
-            if name in self.averaged:             # the mean speed over [t - Ts, t]
+            if name in self.averaged:             # the mean speed over the window ending at the last edge
                 row[self.index(f"mean:{name}")] = 1.0 / Ts
-                values.append(self.mean_speed(name, t - Ts, t))
+                row[self.index(f"edge:{name}")] = 1.0 / Ts
+                row[self.index(f"edge_prev:{name}")] = -1.0 / Ts
+                lag = self.speed_sensors[name].window_lag(states[name])
+                values.append(self.mean_speed(name, t - Ts - lag, t - lag))
             elif name in ("w_in", "w_out"):
                 row[self.index(name)] = 1.0
                 values.append(states[name])
@@ -284,9 +298,13 @@ class TCUModelBuilder:
         """The noise-free pressure reading on the nominal trajectory at t [Pa] (the lagged valve pressure)."""
         return self._sensor_nominal(t)
 
-    def _process_noise(self, Ts):
+    def _process_noise(self, Ts, t):
         n_a = len(self.names)
         q = np.zeros(n_a)
+        x, _, _ = self.trajectory(t + Ts)
+        states = dict(zip(self.lin.all_states, x))
+        for name in self.averaged:
+            q[self.index(f"edge:{name}")] = self.speed_sensors[name].boundary_variance(states[name])
         J_in, J_out = self.inertias
         T = self.spec.estimator["torque_noise"]
         q[self.index("w_in")] = (Ts * T / J_in) ** 2
@@ -297,13 +315,18 @@ class TCUModelBuilder:
             q[self.index(f"d:{name}")] = self.spec.estimator["parameter_drift"] ** 2
         return np.diag(q)
 
-    def _reading_noise(self, y_nominal, Ts):
+    def _reading_noise(self, y_nominal, Ts, t):
         variances = []
         for name, value in zip(self.measured, y_nominal):
-            if name == "w_in":
-                v = self.sensors.input_speed.variance(value, Ts)
-            elif name == "w_out":
-                v = self.sensors.output_speed.variance(value, Ts)
+            if name in self.averaged:
+                # white: the sensor's noise, and the window's age spread uniformly over a tooth period
+                sensor = self.speed_sensors[name]
+                period = 2 * sensor.window_lag(value)
+                acceleration = (self.mean_speed(name, t - 0.5 * Ts, t) - self.mean_speed(name, t - Ts, t - 0.5 * Ts)) \
+                    / (0.5 * Ts)
+                v = sensor.noise ** 2 + (acceleration * period) ** 2 / 12
+            elif name in ("w_in", "w_out"):
+                v = self.speed_sensors[name].variance(value, Ts)
             elif name == "p_sensor":
                 v = self.sensors.pressure.noise ** 2
             else:
@@ -316,12 +339,14 @@ class TCUModelBuilder:
     def _prior(self, y0, Ts):
         n_a = len(self.names)
         p0 = np.zeros(n_a)
-        R0 = np.diag(self._reading_noise(y0, Ts))
         for j, name in enumerate(self.measured):
             if name in ("w_in", "w_out"):          # the speeds before the shift, as read
-                p0[self.index(name)] = R0[j]
+                sensor = self.speed_sensors[name]
+                p0[self.index(name)] = sensor.variance(y0[j], Ts)
                 if name in self.averaged:
-                    p0[self.index(f"mean:{name}")] = Ts ** 2 * R0[j]
+                    p0[self.index(f"mean:{name}")] = Ts ** 2 * p0[self.index(name)]
+                    p0[self.index(f"edge:{name}")] = p0[self.index(f"edge_prev:{name}")] = \
+                        sensor.boundary_variance(y0[j])
         for name, width in self.spec.estimated_parameters.items():
             p0[self.index(f"d:{name}")] = width ** 2 / 3.0
         if self.offset > 0:

@@ -96,6 +96,29 @@ class SpeedSensor:
         pitch_sum = self.pitch_error ** 2 / 3 * r * (1 - r / self.teeth)     # var of the sum of r of Z closing errors
         return speed ** 2 * (self.timer_resolution ** 2 / (6 * sample_time ** 2) + pitch_sum / n ** 2) + noise
 
+    def boundary_variance(self, speed):
+        """Variance [rad^2] of the angle error at the edge that ends a reading's window (and starts the next one's).
+
+        A tooth-wheel reading is the angle between two boundary edges over their time, so its error is
+        (E_k - E_k-1) / Ts with E the angle error at the boundary: the cumulative pitch error of the edge,
+        p^2 (pitch_error^2 / 3) Z / 6 averaged over the wheel (a bridge of Z uniform errors that closes),
+        and the timer's error as an angle, speed^2 q^2 / 12 (edge timing), or the count's fractional part,
+        p^2 / 12 (counting). Consecutive readings share their boundary: their errors are anticorrelated.
+        """
+        if self.method == "ideal":
+            return 0.0
+        pitch = 2 * math.pi / self.teeth
+        teeth = pitch ** 2 * self.pitch_error ** 2 / 3 * self.teeth / 6
+        if self.method == "counting":
+            return teeth + pitch ** 2 / 12
+        return teeth + speed ** 2 * self.timer_resolution ** 2 / 12
+
+    def window_lag(self, speed):
+        """Mean age [s] of the last edge at a sample: half a tooth period (a reading's window ends there)."""
+        if self.method != "edge_timing" or speed <= 0:
+            return 0.0
+        return math.pi / (self.teeth * speed)
+
     def describe(self):
         """One line for reports."""
         if self.method == "ideal":

@@ -18,6 +18,7 @@ field::
     slip_rate_tolerance = 0.1        # slip-rate error, fraction of initial slip / nominal lock time
     integral_tolerance = 0.01        # slip-error integral, fraction of initial slip x nominal lock time
     correction_tolerance = 0.3       # feedback correction, fraction of the pressure range
+    correction_rate_tolerance = 0.05 # kalman: change of the correction per sample, fraction of the pressure range
     terminal_weight = 10.0           # the state weights at lock-up are this many times larger
 
     [anti_windup]
@@ -108,6 +109,7 @@ _LQI = {
     "slip_rate_tolerance": ("1", "positive", 0.1),
     "integral_tolerance": ("1", "positive", 0.01),
     "correction_tolerance": ("1", "positive", 0.3),
+    "correction_rate_tolerance": ("1", "positive", None),
     "terminal_weight": ("1", "nonnegative", 10.0),
 }
 _ANTI_WINDUP = {"method": ("choice", ANTI_WINDUP, "clamping")}

@@ -176,7 +176,10 @@ class TCUFeedback:
         """
         if not 0 <= k < self.horizon:
             raise ModelError(f"TCUFeedback.step: sample {k} outside the design's 0 .. {self.horizon - 1}")
-        out = self._step.call(self.inputs(k, readings))
+        inputs = self.inputs(k, readings)
+        # the innovation, kept for diagnostics (the filter's consistency): y - y_ref - C x_prior
+        self.innovation = inputs["y"] - inputs["y_ref"] - inputs["C"] @ self.x_prior
+        out = self._step.call(inputs)
         u, du, u_unsat = (float(out[key]) for key in ("u", "du", "u_unsat"))
         self.x_post = np.array(out["x_post"], float).ravel()
         self.x_prior = np.array(out["x_next"], float).ravel()

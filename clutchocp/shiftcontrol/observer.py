@@ -35,12 +35,15 @@ variance w^2 / 3), the pressure offset's, the speeds' reading variance.
 
 from dataclasses import dataclass
 
+import math
+
 import numpy as np
 from scipy.linalg import expm
 
 from ..control.kalman import tvkf
 
 SUBSTEPS = 8            # sub-intervals per sample (per part of a sample split at the dead time)
+ACCELERATION_SPREAD = 0.2   # a clutch's shaft acceleration may differ from the nominal by this fraction
 
 
 @dataclass
@@ -67,6 +70,10 @@ class TCUModel:
     durations : (N,)
         Sample lengths [s] (the last one ends at the nominal lock-up).
     Q : (N, n, n), R : (N, p, p), P0 : (n, n)
+    t_ref : (N, p)
+        The time each reading stands for on the nominal trajectory [s].
+    rate_ref : (N, p)
+        The nominal rate of change of each reading's reference there [unit/s].
     """
 
     names: tuple
@@ -83,6 +90,8 @@ class TCUModel:
     Q: np.ndarray
     R: np.ndarray
     P0: np.ndarray
+    t_ref: np.ndarray
+    rate_ref: np.ndarray
 
     def kalman(self):
         """Gains and covariances of the time-varying Kalman filter (:func:`clutchocp.control.kalman.tvkf`)."""
@@ -255,8 +264,10 @@ class TCUModelBuilder:
         rate_end[params] = end_state[4][sig["slip_rate"]]
         Q = np.array([self._process_noise(Ts, t) for t in sample_times])
         R = np.array([self._reading_noise(y_ref[k], Ts, t) for k, t in enumerate(sample_times)])
+        times = np.array([self.reading_times(t, Ts)[0] for t in sample_times])
+        rates = np.array([self.reading_times(t, Ts)[1] for t in sample_times])
         return TCUModel(self.names, self.measured, A, B, C, y_ref, slip, rate, slip_end, rate_end, durations, Q, R,
-                        self._prior(y_ref[0], Ts))
+                        self._prior(y_ref[0], Ts), times, rates)
 
     def _readings(self, t, Ts):
         """(C rows, nominal readings) at time t."""
@@ -266,12 +277,12 @@ class TCUModelBuilder:
         rows, values = [], []
         for name in self.measured:
             row = np.zeros(n_a)
-            if name in self.averaged:             # the mean speed over the window ending at the last edge
+            if name in self.averaged:             # the mean speed over the window, on average
                 row[self.index(f"mean:{name}")] = 1.0 / Ts
                 row[self.index(f"edge:{name}")] = 1.0 / Ts
                 row[self.index(f"edge_prev:{name}")] = -1.0 / Ts
-                lag = self.speed_sensors[name].window_lag(states[name])
-                values.append(self.mean_speed(name, t - Ts - lag, t - lag))
+                middle = self.speed_sensors[name].reading_time(t, Ts, states[name])
+                values.append(self.mean_speed(name, middle - 0.5 * Ts, middle + 0.5 * Ts))
             elif name in ("w_in", "w_out"):
                 row[self.index(name)] = 1.0
                 values.append(states[name])
@@ -315,16 +326,35 @@ class TCUModelBuilder:
             q[self.index(f"d:{name}")] = self.spec.estimator["parameter_drift"] ** 2
         return np.diag(q)
 
+    def reading_times(self, t, Ts):
+        """(times, rates) of the readings at sample time t: the time each stands for on average [s] and the
+        nominal rate of change of its reference there (per s; the TCU moves a reading that stands for another
+        time by the rate times the difference)."""
+        x, _, _ = self.trajectory(t)
+        states = dict(zip(self.lin.all_states, x))
+        times, rates = [], []
+        for name in self.measured:
+            if name in self.averaged:
+                middle = self.speed_sensors[name].reading_time(t, Ts, states[name])
+                h = 0.25 * Ts
+                times.append(middle)
+                rates.append((self.mean_speed(name, middle - 0.5 * Ts + h, middle + 0.5 * Ts + h)
+                              - self.mean_speed(name, middle - 0.5 * Ts - h, middle + 0.5 * Ts - h)) / (2 * h))
+            else:
+                times.append(t)
+                rates.append(0.0)
+        return np.array(times), np.array(rates)
+
     def _reading_noise(self, y_nominal, Ts, t):
         variances = []
-        for name, value in zip(self.measured, y_nominal):
+        _, rates = self.reading_times(t, Ts)
+        for name, value, rate in zip(self.measured, y_nominal, rates):
             if name in self.averaged:
-                # white: the sensor's noise, and the window's age spread uniformly over a tooth period
+                # white: the sensor's noise; and the window's middle, spread uniformly over a tooth period,
+                # moved with the nominal acceleration: the clutch's may be off by ACCELERATION_SPREAD of it
                 sensor = self.speed_sensors[name]
-                period = 2 * sensor.window_lag(value)
-                acceleration = (self.mean_speed(name, t - 0.5 * Ts, t) - self.mean_speed(name, t - Ts, t - 0.5 * Ts)) \
-                    / (0.5 * Ts)
-                v = sensor.noise ** 2 + (acceleration * period) ** 2 / 12
+                period = 2 * math.pi / (sensor.teeth * max(abs(value), 1e-6)) if sensor.method == "edge_timing" else 0.0
+                v = sensor.noise ** 2 + (ACCELERATION_SPREAD * rate * period) ** 2 / 12
             elif name in ("w_in", "w_out"):
                 v = self.speed_sensors[name].variance(value, Ts)
             elif name == "p_sensor":

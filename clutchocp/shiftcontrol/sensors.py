@@ -14,11 +14,11 @@ eps_m uniform in +-``pitch_error``, their mean removed so that the wheel closes)
 
 * ``edge_timing``: a capture timer of resolution q stamps each edge (t_q = floor(t / q) q, the
   timer's phase random). At t_k the TCU takes the last edge before the previous sample and the
-  edges since, e_0 < ... < e_n, and reports w = (sum_i c_i) (2 pi / Z) / (e_n - e_0), with c_i the
-  pitches an interval spans (1, or more where an edge was missed: an interval c times the median
-  one counts c, the TCU's plausibility check against dropouts). At a constant speed w this is w
-  within the quantisation, |w_meas / w - 1| <= q / (e_n - e_0); with pitch errors it is
-  w n / (n + sum eps) over the n teeth passed.
+  edges since, e_0 < ... < e_n, and reports w = (angle from e_0 to e_n) / (e_n - e_0), the angle
+  being the teeth counted between them times 2 pi / Z (the TCU counts its teeth; a missed edge is a
+  gap of two periods and counts two), or the learned angles of those edges (``learned_revolutions``).
+  At a constant speed w this is w within the quantisation, |w_meas / w - 1| <= q / (e_n - e_0);
+  with pitch errors it is w n / (n + sum eps) over the n teeth passed.
 * ``counting``: the edges in the last sample (t_{k-1}, t_k] times 2 pi / (Z Ts): at a constant speed
   floor(Z w Ts / 2 pi) or one more.
 * ``ideal``: the plant's speed at t_k.
@@ -61,6 +61,11 @@ class SpeedSensor:
         Probability that an edge is missed, in [0, 1).
     noise : float
         Standard deviation of white noise added to each reading [rad/s].
+    learned_revolutions : int
+        Revolutions at steady speed over which the TCU has learned its wheel's tooth pitches before the
+        shift (0: it takes every pitch as 2 pi / Z). The learning is simulated: the same timer stamps the
+        edges of that many revolutions at the speed before the shift, and each edge's learned angle is its
+        mean share of the revolution time (tooth-error adaptation).
     """
 
     method: str = "ideal"
@@ -69,6 +74,7 @@ class SpeedSensor:
     pitch_error: float = 0.0
     dropout: float = 0.0
     noise: float = 0.0
+    learned_revolutions: int = 0
 
     def __post_init__(self):
         if self.method not in SPEED_METHODS:
@@ -111,13 +117,19 @@ class SpeedSensor:
         teeth = pitch ** 2 * self.pitch_error ** 2 / 3 * self.teeth / 6
         if self.method == "counting":
             return teeth + pitch ** 2 / 12
-        return teeth + speed ** 2 * self.timer_resolution ** 2 / 12
+        stamp = speed ** 2 * self.timer_resolution ** 2 / 12
+        if self.learned_revolutions:
+            # the learned angle of an edge: from three stamps per revolution, averaged over the revolutions
+            teeth = 2 * stamp / self.learned_revolutions
+        return teeth + stamp
 
-    def window_lag(self, speed):
-        """Mean age [s] of the last edge at a sample: half a tooth period (a reading's window ends there)."""
-        if self.method != "edge_timing" or speed <= 0:
-            return 0.0
-        return math.pi / (self.teeth * speed)
+    def reading_time(self, t, sample_time, speed):
+        """The time a reading at t stands for, on average [s]: t (ideal), the middle of the last sample
+        (counting), that less half a tooth period (edge timing: the window ends at the last edge)."""
+        if self.method == "ideal":
+            return t
+        lag = math.pi / (self.teeth * speed) if self.method == "edge_timing" and speed > 0 else 0.0
+        return t - 0.5 * sample_time - lag
 
     def describe(self):
         """One line for reports."""
@@ -128,6 +140,8 @@ class SpeedSensor:
             parts.append(f"timer {self.timer_resolution * 1e6:g} us")
         if self.pitch_error:
             parts.append(f"pitch error +-{100 * self.pitch_error:g} %")
+        if self.learned_revolutions:
+            parts.append(f"pitches learned over {self.learned_revolutions} revolutions")
         if self.dropout:
             parts.append(f"dropout {self.dropout:g}")
         if self.noise:
@@ -161,9 +175,28 @@ class SpeedChannel:
         self._next = 0                        # index of the next edge to pass
         self.stamps = []                      # recorded (quantised) edge times [s]
         self.true_times = []                  # the exact times of the recorded edges [s]
+        self.teeth_seen = []                  # the edge number of each recorded edge (the TCU counts its teeth)
+        self.learned = self._learn(speed) if sensor.learned_revolutions else \
+            np.arange(sensor.teeth) * (2 * math.pi / sensor.teeth)
         start = t0 - HISTORY_SAMPLES * sample_time
         self._t = start
         self.advance(np.array([start, t0]), np.array([speed, speed]))
+
+    def _learn(self, speed):
+        """Learned edge angles of one revolution (edge 0 at 0): the mean share of the revolution time of each
+        edge over ``learned_revolutions`` revolutions at ``speed``, stamped by the same timer."""
+        Z, R, q = self.sensor.teeth, self.sensor.learned_revolutions, self.sensor.timer_resolution
+        angles = self.edges[None, :] + 2 * math.pi * np.arange(R)[:, None]          # (R, Z) from edge 0
+        angles = np.append(angles.ravel(), 2 * math.pi * R)
+        stamps = np.floor((angles / speed + self._timer_phase) / q) * q if q > 0 else angles / speed
+        start = stamps[:-1:Z]
+        shares = (stamps[:-1].reshape(R, Z) - start[:, None]) / (stamps[Z::Z] - start)[:, None]
+        return 2 * math.pi * shares.mean(axis=0)
+
+    def learned_angle(self, j):
+        """The angle [rad] the TCU takes for edge j (its learned pitches, or j 2 pi / Z)."""
+        Z = self.sensor.teeth
+        return (j // Z) * 2 * math.pi + self.learned[j % Z]
 
     def edge_angle(self, j):
         """Angle [rad] of edge j (counted from the start, j = 0, 1, ...)."""
@@ -200,10 +233,16 @@ class SpeedChannel:
         stamp = math.floor((t_edge + self._timer_phase) / q) * q - self._timer_phase if q > 0 else t_edge
         self.stamps.append(stamp)
         self.true_times.append(t_edge)
+        self.teeth_seen.append(self._next)
 
     def read(self, t):
-        """The speed reading at the TCU sample ``t`` [s] (the channel fed up to ``t`` at least)."""
+        """The speed reading at the TCU sample ``t`` [s] (the channel fed up to ``t`` at least).
+
+        ``self.time`` is then the time the reading stands for [s]: t for an ideal sensor, the middle of the
+        window for a tooth wheel (its mean speed is the speed there, for a speed linear in time; the TCU
+        knows it from its stamps, the window's ends)."""
         s = self.sensor
+        self.time = t if s.method == "ideal" else t - 0.5 * self.Ts
         value = self._exact(t) if s.method == "ideal" else self._from_edges(t)
         return value + (s.noise * self.rng.standard_normal() if s.noise else 0.0)
 
@@ -223,11 +262,15 @@ class SpeedChannel:
             window = seen[-2:]
         if window.size < 2:
             return 0.0
-        gaps = np.diff(window)
-        reference = np.median(gaps)
-        counts = np.maximum(np.rint(gaps / reference), 1.0) if reference > 0 else np.ones_like(gaps)
         span = window[-1] - window[0]
-        return float(np.sum(counts) * pitch / span) if span > 0 else 0.0
+        if span <= 0:
+            return 0.0
+        self.time = 0.5 * (window[0] + window[-1])
+        # the angle between the window's edges: the teeth counted between them (a missed edge shows as a
+        # gap of two periods and counts two), with the learned pitches when the TCU has learned them
+        last = len(seen) - 1
+        first = last - (window.size - 1)
+        return float((self.learned_angle(self.teeth_seen[last]) - self.learned_angle(self.teeth_seen[first])) / span)
 
 
 def first_order_lag(t, p, lag, y0):
@@ -469,8 +512,10 @@ class SensorSet:
             self.pressure.advance(t, p)
 
     def read(self, t):
-        """The readings at ``t`` [s]: ``w_in``, ``w_out`` [rad/s] and ``p_valve`` [Pa] (with a pressure sensor)."""
+        """The readings at ``t`` [s]: ``w_in``, ``w_out`` [rad/s] and ``p_valve`` [Pa] (with a pressure sensor);
+        ``time:w_in``, ``time:w_out``: the times the speed readings stand for [s] (see :meth:`SpeedChannel.read`)."""
         out = {name: channel.read(t) for name, channel in self.speeds.items()}
+        out.update({f"time:{name}": channel.time for name, channel in self.speeds.items()})
         if self.pressure is not None:
             out["p_valve"] = self.pressure.read(t)
         return out
@@ -497,7 +542,7 @@ def sensors_from_spec(spec, scene):
         if t is None:
             return SpeedSensor()
         return SpeedSensor(t["method"], int(t["teeth"]), t["timer_resolution"], t["pitch_error"], t["dropout"],
-                           t["noise"])
+                           t["noise"], int(t["learned_revolutions"]))
 
     pressure = None
     if spec.measure_pressure:

@@ -42,6 +42,7 @@ field::
     pitch_error = "0.5 %"            # half-width of each tooth's pitch error (uniform)
     dropout = 0.0                    # probability that an edge is missed
     noise = "0 rad/s"                # white noise on a reading (standard deviation)
+    learned_revolutions = 0          # the TCU learned its tooth pitches over this many steady revolutions
     [sensors.pressure]               # with measure_pressure: without it, the exact valve pressure
     noise = "5 kPa"                  # standard deviation
     offset = "10 kPa"                # half-width of the unit's offset (uniform, per clutch)
@@ -119,7 +120,8 @@ _ESTIMATOR = {"enabled": ("bool", None, False), "method": ("choice", ESTIMATORS,
               "parameter_drift": ("1", "nonnegative", 0.002)}
 _SPEED = {"method": ("choice", SPEED_METHODS, "ideal"), "teeth": ("1", "positive", 60.0),
           "timer_resolution": ("s", "positive", 1e-6), "pitch_error": ("1", "nonnegative", 0.0),
-          "dropout": ("1", "nonnegative", 0.0), "noise": ("rad/s", "nonnegative", 0.0)}
+          "dropout": ("1", "nonnegative", 0.0), "noise": ("rad/s", "nonnegative", 0.0),
+          "learned_revolutions": ("1", "nonnegative", 0.0)}
 _PRESSURE = {"noise": ("Pa", "nonnegative", 0.0), "offset": ("Pa", "nonnegative", 0.0), "lag": ("s", "nonnegative", 0.0)}
 _SUMP = {"error_C": ("1", "nonnegative", 0.0), "oil_viscosity_40C": ("m^2/s", "positive", None),
          "oil_viscosity_100C": ("m^2/s", "positive", None)}
@@ -282,6 +284,11 @@ def _sensor_tables(raw):
             if teeth != int(teeth) or teeth < 2:
                 raise PhysicalRangeError(f"sensors.{name}.teeth = {teeth:g}: must be a whole number >= 2")
             out[name]["teeth"] = int(teeth)
+            revolutions = out[name]["learned_revolutions"]
+            if revolutions != int(revolutions) or revolutions > 10000:
+                raise PhysicalRangeError(f"sensors.{name}.learned_revolutions = {revolutions:g}: must be a whole "
+                                         "number from 0 to 10000")
+            out[name]["learned_revolutions"] = int(revolutions)
             if out[name]["dropout"] >= 0.5:
                 raise PhysicalRangeError(f"sensors.{name}.dropout = {out[name]['dropout']:g}: must be below 0.5 "
                                          "(a probability per edge)")

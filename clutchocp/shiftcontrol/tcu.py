@@ -3,7 +3,8 @@
 At sample k (t_k = k Ts) the TCU reads y_k (speeds from its tooth wheels, the pressure sensor, the
 engine-torque signal) and, with the tables of its calibration for that sample:
 
-    nu      = (y_k - y_ref,k) - C_k xi_k^-                       innovation
+    y       = y_k + r_k (t_ref,k - y_time)                       readings moved to the times of the model
+    nu      = (y - y_ref,k) - C_k xi_k^-                         innovation
     xi_k    = xi_k^- + M_k nu                                    Kalman update
     du_uns  = -K_k [xi_k; z_k]                                   LQR on the TCU's state and the slip-error integral z
     u_uns   = u_ff,k + du_uns
@@ -13,6 +14,9 @@ engine-torque signal) and, with the tables of its calibration for that sample:
     z_k+1   = z_k + dt_k (slip row) xi_k    (not while limited in the direction it would push: clamping)
     xi_k+1^- = A_k xi_k + B_k du
 
+A tooth-wheel reading is the mean speed over its window, i.e. the speed at the window's middle, which
+the TCU knows from its stamps (``y_time``); the model's reading stands for the nominal middle
+(``t_ref``): the difference times the nominal acceleration (``rate_ref``) moves it there.
 u_ff,k is the feedforward at t_k + D (D: the valve dead time the TCU assumes; it sends its command
 that much early); between samples the TCU's output is u_ff(t + D) + du_k. The lock-up counter counts
 the samples in a row with the measured slip within ``lock_slip``; at ``lock_samples`` the TCU hands
@@ -28,7 +32,7 @@ import numpy as np
 
 from ..errors import ModelError
 
-STEP_INPUTS = ("y", "y_ref", "x_prior", "integral", "u_prev", "first", "lock_count", "M", "C", "K", "A", "B",
+STEP_INPUTS = ("y", "y_time", "y_ref", "t_ref", "rate_ref", "x_prior", "integral", "u_prev", "first", "lock_count", "M", "C", "K", "A", "B",
                "slip_row", "dt", "u_ff", "limits")
 STEP_OUTPUTS = ("u", "du", "u_unsat", "x_post", "x_next", "integral_next", "lock_count_next")
 LIMITS = ("p_min", "p_max", "reach", "clamping", "lock_slip")
@@ -38,19 +42,21 @@ LIMITS = ("p_min", "p_max", "reach", "clamping", "lock_slip")
 def step_function(n, p):
     """The per-sample law as a CasADi function for a TCU state of ``n`` and ``p`` readings (see the module docstring).
 
-    Inputs (:data:`STEP_INPUTS`): y, y_ref (p), x_prior (n), integral, u_prev, first (1 at the first sample: no
+    Inputs (:data:`STEP_INPUTS`): y, y_time [s], y_ref, t_ref [s], rate_ref (p), x_prior (n), integral, u_prev, first (1 at the first sample: no
     previous command), lock_count, M (n x p), C (p x n), K (1 x n+1), A (n x n), B (n), slip_row (1 x n),
     dt [s], u_ff [Pa], limits (p_min [Pa], p_max [Pa], reach [Pa], clamping (0/1), lock_slip [rad/s]).
     Outputs (:data:`STEP_OUTPUTS`): u, du, u_unsat [Pa], x_post, x_next (n), integral_next, lock_count_next.
     """
     sx = ca.SX.sym
-    y, y_ref, x_prior = sx("y", p), sx("y_ref", p), sx("x_prior", n)
+    y, y_time, y_ref, x_prior = sx("y", p), sx("y_time", p), sx("y_ref", p), sx("x_prior", n)
+    t_ref, rate_ref = sx("t_ref", p), sx("rate_ref", p)
     integral, u_prev, first, lock_count = sx("integral"), sx("u_prev"), sx("first"), sx("lock_count")
     M, C, K, A, B = sx("M", n, p), sx("C", p, n), sx("K", 1, n + 1), sx("A", n, n), sx("B", n)
     slip_row, dt, u_ff, limits = sx("slip_row", 1, n), sx("dt"), sx("u_ff"), sx("limits", len(LIMITS))
     p_min, p_max, reach, clamping, lock_slip = (limits[i] for i in range(len(LIMITS)))
 
-    x_post = x_prior + ca.mtimes(M, (y - y_ref) - ca.mtimes(C, x_prior))
+    y_model = y + rate_ref * (t_ref - y_time)
+    x_post = x_prior + ca.mtimes(M, (y_model - y_ref) - ca.mtimes(C, x_prior))
     k_xi = K[0, n]
     u_unsat = u_ff - ca.mtimes(K[0, :n], x_post) - k_xi * integral
     u = ca.fmin(ca.fmax(u_unsat, p_min), p_max)
@@ -64,7 +70,7 @@ def step_function(n, p):
     increment = ca.if_else(ca.logic_and(ca.logic_and(clamping, limited), pushes), 0.0, increment)
     outputs = [u, du, u_unsat, x_post, ca.mtimes(A, x_post) + B * du, integral + increment,
                ca.if_else(near, lock_count + 1, 0.0)]
-    inputs = [y, y_ref, x_prior, integral, u_prev, first, lock_count, M, C, K, A, B, slip_row, dt, u_ff, limits]
+    inputs = [y, y_time, y_ref, t_ref, rate_ref, x_prior, integral, u_prev, first, lock_count, M, C, K, A, B, slip_row, dt, u_ff, limits]
     return ca.Function("tcu_step", inputs, outputs, list(STEP_INPUTS), list(STEP_OUTPUTS))
 
 
@@ -80,7 +86,8 @@ class TCUFeedback:
     tables : dict of arrays
         Per sample k = 0 .. N-1: ``A`` (N, n, n), ``B`` (N, n), ``C`` (N, p, n), ``M`` (N, n, p) Kalman gains,
         ``K`` (N, n + 1) LQR gains on [xi; z], ``y_ref`` (N, p), ``slip_row`` (N, n), ``dt`` (N,) [s],
-        ``u_ff`` (N,) the feedforward at t_k + D [Pa].
+        ``u_ff`` (N,) the feedforward at t_k + D [Pa], ``t_ref`` (N, p) the time each reading stands for
+        on the nominal trajectory [s], ``rate_ref`` (N, p) the nominal rate of each reading there.
     feedforward : (array, array)
         The feedforward curve [s], [Pa] as the plant should receive it (piecewise linear, last value held).
     advance : float
@@ -107,7 +114,7 @@ class TCUFeedback:
         self.tables = {key: np.asarray(value, float) for key, value in tables.items()}
         N, n, p = self.tables["A"].shape[0], len(self.names), len(self.measured)
         shapes = {"A": (N, n, n), "B": (N, n), "C": (N, p, n), "M": (N, n, p), "K": (N, n + 1), "y_ref": (N, p),
-                  "slip_row": (N, n), "dt": (N,), "u_ff": (N,)}
+                  "slip_row": (N, n), "dt": (N,), "u_ff": (N,), "t_ref": (N, p), "rate_ref": (N, p)}
         for key, shape in shapes.items():
             if self.tables.get(key) is None or self.tables[key].shape != shape:
                 raise ModelError(f"TCUFeedback: table {key} must be {shape}")
@@ -153,17 +160,22 @@ class TCUFeedback:
         t = self.tables
         return {"M": t["M"][k], "C": t["C"][k], "K": t["K"][k][None, :], "A": t["A"][k], "B": t["B"][k],
                 "slip_row": t["slip_row"][k][None, :], "dt": t["dt"][k], "u_ff": t["u_ff"][k],
-                "y_ref": t["y_ref"][k], "limits": self.limits()}
+                "y_ref": t["y_ref"][k], "t_ref": t["t_ref"][k], "rate_ref": t["rate_ref"][k], "limits": self.limits()}
 
     def readings_vector(self, readings):
         """The readings in the order of ``measured`` (``p_sensor`` is the pressure reading ``p_valve``)."""
         key = {"p_sensor": "p_valve"}
         return np.array([readings[key.get(name, name)] for name in self.measured], float)
 
+    def reading_times(self, k, readings):
+        """The times the readings stand for (``time:<name>`` in ``readings``; else the model's own)."""
+        return np.array([readings.get(f"time:{name}", self.tables["t_ref"][k][j])
+                         for j, name in enumerate(self.measured)], float)
+
     def inputs(self, k, readings):
         """Every input of :func:`step_function` at sample k for the readings (dict), from the current state."""
         first = self._u_prev is None
-        return {"y": self.readings_vector(readings), "x_prior": self.x_prior, "integral": self.integral,
+        return {"y": self.readings_vector(readings), "y_time": self.reading_times(k, readings), "x_prior": self.x_prior, "integral": self.integral,
                 "u_prev": 0.0 if first else self._u_prev, "first": float(first), "lock_count": float(self.lock_count),
                 **self.row(k)}
 
@@ -178,7 +190,8 @@ class TCUFeedback:
             raise ModelError(f"TCUFeedback.step: sample {k} outside the design's 0 .. {self.horizon - 1}")
         inputs = self.inputs(k, readings)
         # the innovation, kept for diagnostics (the filter's consistency): y - y_ref - C x_prior
-        self.innovation = inputs["y"] - inputs["y_ref"] - inputs["C"] @ self.x_prior
+        y = inputs["y"] + inputs["rate_ref"] * (inputs["t_ref"] - inputs["y_time"])
+        self.innovation = y - inputs["y_ref"] - inputs["C"] @ self.x_prior
         out = self._step.call(inputs)
         u, du, u_unsat = (float(out[key]) for key in ("u", "du", "u_unsat"))
         self.x_post = np.array(out["x_post"], float).ravel()

@@ -23,11 +23,14 @@ JSON (and the C function takes them as arguments) for the calibration tool chain
 """
 
 import json
+import shutil
+import subprocess
 from pathlib import Path
 
 import casadi as ca
 import numpy as np
 
+from ..errors import ModelError
 from ..output import write_csv
 from .tcu import LIMITS, STEP_INPUTS, STEP_OUTPUTS, step_function
 
@@ -155,7 +158,7 @@ def _entries(f, names, measured):
 
 
 def _estimator_csv(path, feedbacks, names, measured):
-    columns = {key: [] for key in ("design", "matrix", "sample", "row", "column", "value [SI, unit column]", "unit")}
+    columns = {key: [] for key in ("design", "matrix", "sample", "row", "column", "value [SI: unit column]", "unit")}
     for d, f in enumerate(feedbacks):
         for entry in _entries(f, names, measured):
             for key, value in zip(list(columns)[1:], entry):
@@ -194,3 +197,68 @@ def generate_c(out, n, p):
     generator.add(step_function(n, p))
     generator.generate(str(out) + "/")
     return [out / f"{C_NAME}.c", out / f"{C_NAME}.h"]
+
+
+def compiler():
+    """The machine's C compiler (``cc``, else ``gcc`` or ``clang``), or None."""
+    return next((path for path in map(shutil.which, ("cc", "gcc", "clang")) if path), None)
+
+
+def compile_shared(folder, cc=None):
+    """Compile ``tcu_step.c`` of ``folder`` into a shared library (``libtcu_step.so``); returns its path."""
+    cc = cc or compiler()
+    if cc is None:
+        raise ModelError("no C compiler (cc, gcc, clang) on this machine")
+    folder = Path(folder)
+    library = folder / f"lib{C_NAME}.so"
+    subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", str(library), str(folder / f"{C_NAME}.c"), "-lm"],
+                   check=True, capture_output=True)
+    return library
+
+
+def time_c_step(folder, inputs, repeats=200_000, cc=None):
+    """Seconds per call of the generated ``tcu_step`` on one sample's inputs (a dict by input name), measured by
+    a C loop compiled with -O2 beside it (the time of the law alone, without Python)."""
+    cc = cc or compiler()
+    if cc is None:
+        raise ModelError("no C compiler (cc, gcc, clang) on this machine")
+    folder = Path(folder)
+    f = step_function(*_sizes(inputs))
+    arrays, pointers = [], []
+    for i, name in enumerate(STEP_INPUTS):
+        values = np.asarray(ca.DM(inputs[name]).full(), float).ravel(order="F")
+        arrays.append(f"static const casadi_real in{i}[{max(values.size, 1)}] = {{"
+                      + ", ".join(repr(float(v)) for v in values) + "};")
+        pointers.append(f"in{i}")
+    outputs = [f"static casadi_real out{i}[{max(f.nnz_out(i), 1)}];" for i in range(f.n_out())]
+    source = f"""#include <stdio.h>
+#include <time.h>
+#include "{C_NAME}.h"
+{chr(10).join(arrays)}
+{chr(10).join(outputs)}
+int main(void) {{
+  const casadi_real* arg[{max(f.sz_arg(), f.n_in())}] = {{{", ".join(pointers)}}};
+  casadi_real* res[{max(f.sz_res(), f.n_out())}] = {{{", ".join(f"out{i}" for i in range(f.n_out()))}}};
+  static casadi_int iw[{max(f.sz_iw(), 1)}];
+  static casadi_real w[{max(f.sz_w(), 1)}];
+  struct timespec a, b;
+  volatile casadi_real sink = 0;
+  clock_gettime(CLOCK_MONOTONIC, &a);
+  for (long i = 0; i < {int(repeats)}; ++i) {{ {C_NAME}(arg, res, iw, w, 0); sink += out0[0]; }}
+  clock_gettime(CLOCK_MONOTONIC, &b);
+  printf("%.9e\\n", ((b.tv_sec - a.tv_sec) + 1e-9 * (b.tv_nsec - a.tv_nsec)) / {int(repeats)});
+  return 0;
+}}
+"""
+    bench = folder / "tcu_step_bench.c"
+    bench.write_text(source, encoding="utf-8")
+    program = folder / "tcu_step_bench"
+    subprocess.run([cc, "-O2", "-o", str(program), str(bench), str(folder / f"{C_NAME}.c"), "-lm"], check=True,
+                   capture_output=True)
+    done = subprocess.run([str(program)], check=True, capture_output=True, text=True)
+    return float(done.stdout.strip())
+
+
+def _sizes(inputs):
+    """(n, p) of the step function from a sample's inputs."""
+    return int(np.size(inputs["x_prior"])), int(np.size(inputs["y"]))

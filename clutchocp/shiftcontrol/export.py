@@ -41,7 +41,7 @@ def state_unit(name):
     """SI unit of a TCU state or reading."""
     if name.startswith("d:"):
         return "1"
-    if name.startswith("mean:"):
+    if name.startswith(("mean:", "edge:", "edge_prev:")):
         return "rad"
     if name.startswith("h_"):
         return "m"

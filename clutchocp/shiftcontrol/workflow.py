@@ -91,8 +91,8 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
     feedforward = ("nominal_optimum", opt.command_times, opt.command)
     facts = {"t_max_s": t_max, "nominal_optimum": {k: opt.terms[k] for k in
                                                    ("engagement_time_s", "jerk_integral", "lockup_torque_jump_Nm")}}
-    robust, rob = robust_solver(), None
     wanted = "robust_feedforward" in chosen or ("closed_loop" in chosen and spec.feedforward_curve == "robust")
+    robust, rob = robust_solver() if wanted else None, None
     if not wanted:
         facts["robust_feedforward"] = "not asked for (--strategies)"
     elif robust is None:

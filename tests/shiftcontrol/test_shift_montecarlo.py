@@ -163,10 +163,10 @@ def test_a_subset_of_strategies_skips_the_robust_feedforward(monkeypatch):
     from clutchocp.shiftcontrol import workflow
     from clutchocp.shiftcontrol.spec import load_slip_spec
 
-    def no_robust():
+    def solve(*args, **kwargs):
         raise AssertionError("the robust feedforward was solved although not asked for")
 
-    monkeypatch.setattr(workflow, "robust_solver", no_robust)
+    monkeypatch.setattr(workflow, "robust_solver", lambda: (solve, lambda scene, corners: []))
     scene = default_scene()
     spec = replace(load_slip_spec(), schedule_field="")
     strategies, facts = workflow.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene), spec,

@@ -118,7 +118,7 @@ def design_tcu_feedback(scene, command_times, command, spec, sensors, *, model=N
     M, P_prior, P_post = tcu_model.kalman()
     w_rel0 = float(trajectory(0.0)[0][lin.all_states.index("w_in")] - trajectory(0.0)[0][lin.all_states.index("w_out")])
     K = _tcu_lqr(spec.lqi, tcu_model, w_rel0, t_lock, p_hi - p_lo)
-    lock = nominal.result.events[0] if nominal.result.events else None
+    lock = next((e for e in nominal.result.events if e.name == "lockup"), None)
     w_lock = lock.x_after["w_in"] if lock is not None and "w_in" in lock.x_after else float(x_slip[-1, 0])
     lock_slip = spec.lock["slip"]
     if lock_slip is None:

@@ -298,7 +298,7 @@ class TCUModelBuilder:
         return np.array(rows), np.array(values)
 
     def mean_speed(self, name, t0, t1, points=41):
-        """Mean of the nominal speed ``name`` over [t0, t1] [rad/s] (before t = 0: the initial speed), Simpson's rule."""
+        """Mean of the nominal speed ``name`` over [t0, t1] [rad/s] (before t = 0: the initial speed); Simpson."""
         j = self.lin.all_states.index(name)
         t = np.linspace(t0, t1, points)
         w = np.array([self.trajectory(max(ti, 0.0))[0][j] for ti in t])

@@ -27,7 +27,8 @@ Every speed channel may add white noise (``noise`` [rad/s], standard deviation).
 Kalman filter is designed with (:meth:`SpeedSensor.variance`) is that of these errors at a constant
 speed: w^2 (q^2 / (6 Ts^2) + pitch_error^2 r (1 - r / Z) / (3 n^2)) + noise^2 for edge timing (two
 independent quantised stamps; n = w Ts Z / 2 pi teeth passed, of which the r = n mod Z beyond whole
-revolutions carry the error of r of Z uniform errors whose sum over the wheel is zero), (2 pi / (Z Ts))^2 / 6 + noise^2 for counting
+revolutions carry the error of r of Z uniform errors whose sum over the wheel is zero),
+(2 pi / (Z Ts))^2 / 6 + noise^2 for counting
 (the count's fractional part f makes it one edge off with probability f; f (1 - f) averaged over a
 uniform f is 1/6), noise^2 for an ideal sensor.
 """

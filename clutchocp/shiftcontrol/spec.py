@@ -27,7 +27,7 @@ field::
     [estimator]                      # the command rescaled to the clutch met (torque gain and load from the speeds)
     enabled = true
     method = "difference"            # or "kalman": a Kalman filter on the linearised engagement (below)
-    activation = 0.5                 # difference: adapt while the nominal clutch torque is above this fraction of its peak
+    activation = 0.5                 # difference: adapt while the nominal clutch torque exceeds this share of its peak
     gain_limit = 1.5                 # difference: largest ratio of nominal to estimated torque gain (and its inverse)
     torque_noise = "5 N m"           # kalman: unmodelled torque on each rotor (standard deviation over a sample)
     pressure_noise = "5 kPa"         # kalman: unmodelled valve pressure per sample (standard deviation)
@@ -122,7 +122,8 @@ _SPEED = {"method": ("choice", SPEED_METHODS, "ideal"), "teeth": ("1", "positive
           "timer_resolution": ("s", "positive", 1e-6), "pitch_error": ("1", "nonnegative", 0.0),
           "dropout": ("1", "nonnegative", 0.0), "noise": ("rad/s", "nonnegative", 0.0),
           "learned_revolutions": ("1", "nonnegative", 0.0)}
-_PRESSURE = {"noise": ("Pa", "nonnegative", 0.0), "offset": ("Pa", "nonnegative", 0.0), "lag": ("s", "nonnegative", 0.0)}
+_PRESSURE = {"noise": ("Pa", "nonnegative", 0.0), "offset": ("Pa", "nonnegative", 0.0),
+             "lag": ("s", "nonnegative", 0.0)}
 _SUMP = {"error_C": ("1", "nonnegative", 0.0), "oil_viscosity_40C": ("m^2/s", "positive", None),
          "oil_viscosity_100C": ("m^2/s", "positive", None)}
 _TORQUE = {"source": ("choice", TORQUE_SOURCES, "nominal"), "error": ("1", "nonnegative", 0.0),

@@ -32,8 +32,8 @@ import numpy as np
 
 from ..errors import ModelError
 
-STEP_INPUTS = ("y", "y_time", "y_ref", "t_ref", "rate_ref", "x_prior", "integral", "u_prev", "first", "lock_count", "M", "C", "K", "A", "B",
-               "slip_row", "dt", "u_ff", "limits")
+STEP_INPUTS = ("y", "y_time", "y_ref", "t_ref", "rate_ref", "x_prior", "integral", "u_prev", "first", "lock_count",
+               "M", "C", "K", "A", "B", "slip_row", "dt", "u_ff", "limits")
 STEP_OUTPUTS = ("u", "du", "u_unsat", "x_post", "x_next", "integral_next", "lock_count_next")
 LIMITS = ("p_min", "p_max", "reach", "clamping", "lock_slip")
 
@@ -42,8 +42,8 @@ LIMITS = ("p_min", "p_max", "reach", "clamping", "lock_slip")
 def step_function(n, p):
     """The per-sample law as a CasADi function for a TCU state of ``n`` and ``p`` readings (see the module docstring).
 
-    Inputs (:data:`STEP_INPUTS`): y, y_time [s], y_ref, t_ref [s], rate_ref (p), x_prior (n), integral, u_prev, first (1 at the first sample: no
-    previous command), lock_count, M (n x p), C (p x n), K (1 x n+1), A (n x n), B (n), slip_row (1 x n),
+    Inputs (:data:`STEP_INPUTS`): y, y_time [s], y_ref, t_ref [s], rate_ref (p), x_prior (n), integral, u_prev,
+    first (1 at the first sample: no previous command), lock_count, M (n x p), C (p x n), K (1 x n+1), A (n x n), B (n), slip_row (1 x n),
     dt [s], u_ff [Pa], limits (p_min [Pa], p_max [Pa], reach [Pa], clamping (0/1), lock_slip [rad/s]).
     Outputs (:data:`STEP_OUTPUTS`): u, du, u_unsat [Pa], x_post, x_next (n), integral_next, lock_count_next.
     """
@@ -70,7 +70,8 @@ def step_function(n, p):
     increment = ca.if_else(ca.logic_and(ca.logic_and(clamping, limited), pushes), 0.0, increment)
     outputs = [u, du, u_unsat, x_post, ca.mtimes(A, x_post) + B * du, integral + increment,
                ca.if_else(near, lock_count + 1, 0.0)]
-    inputs = [y, y_time, y_ref, t_ref, rate_ref, x_prior, integral, u_prev, first, lock_count, M, C, K, A, B, slip_row, dt, u_ff, limits]
+    inputs = [y, y_time, y_ref, t_ref, rate_ref, x_prior, integral, u_prev, first, lock_count, M, C, K, A, B,
+              slip_row, dt, u_ff, limits]
     return ca.Function("tcu_step", inputs, outputs, list(STEP_INPUTS), list(STEP_OUTPUTS))
 
 
@@ -175,7 +176,8 @@ class TCUFeedback:
     def inputs(self, k, readings):
         """Every input of :func:`step_function` at sample k for the readings (dict), from the current state."""
         first = self._u_prev is None
-        return {"y": self.readings_vector(readings), "y_time": self.reading_times(k, readings), "x_prior": self.x_prior, "integral": self.integral,
+        return {"y": self.readings_vector(readings), "y_time": self.reading_times(k, readings),
+                "x_prior": self.x_prior, "integral": self.integral,
                 "u_prev": 0.0 if first else self._u_prev, "first": float(first), "lock_count": float(self.lock_count),
                 **self.row(k)}
 
@@ -226,4 +228,5 @@ class TCUFeedback:
                                        np.interp(times, other.ff_times, other.ff_values))),
                            self.advance, self.p_min, self.p_max, self.rate_limit, self.anti_windup,
                            mix(self.lock_slip, other.lock_slip), self.lock_samples,
-                           mix(self.clamp_pressure, other.clamp_pressure), mix(self.nominal_torque, other.nominal_torque))
+                           mix(self.clamp_pressure, other.clamp_pressure),
+                           mix(self.nominal_torque, other.nominal_torque))

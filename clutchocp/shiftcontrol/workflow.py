@@ -169,8 +169,9 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
 def _closed_loop_strategy(spec, schedule, ff_label, feedforward):
     kalman = schedule.sensors is not None
     adaptive = spec.estimator["enabled"] and schedule.adaptation_off is None
+    designs = f"{len(schedule.feedbacks)} designs over {schedule.field}"
     traits = [t for t, on in (("Kalman filter on its sensors", kalman), ("adaptive", adaptive and not kalman),
-                               (f"{len(schedule.feedbacks)} designs over {schedule.field}", bool(schedule.field))) if on]
+                               (designs, bool(schedule.field))) if on]
     return Strategy("closed_loop", f"slip feedback on {ff_label}" + (f" ({', '.join(traits)})" if traits else ""),
                     feedback=schedule, notes={"feedforward": feedforward})
 

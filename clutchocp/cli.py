@@ -97,6 +97,18 @@ def temperature(text):
     return value
 
 
+STRATEGY_NAMES = ("baseline", "nominal_optimum", "robust_feedforward", "closed_loop")
+
+
+def strategy_list(text):
+    """A comma-separated subset of the robust command's strategies; an argparse ``type=``."""
+    names = [part.strip() for part in text.split(",") if part.strip()]
+    unknown = [n for n in names if n not in STRATEGY_NAMES]
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(f"'{text}': a comma-separated subset of {', '.join(STRATEGY_NAMES)} is allowed")
+    return tuple(dict.fromkeys(names))
+
+
 def _command(name):
     """The command ``name`` of :mod:`clutchocp.commands`, imported when it runs."""
     def run(args):
@@ -245,7 +257,9 @@ def _add_control_commands(sub):
     p.add_argument("--workers", type=count(1, 1024, "parallel processes"), default=None,
                    help="parallel processes (default: the local cores)")
     p.add_argument("--intervals", type=count(2, MAX_INTERVALS, "collocation intervals"), default=60, help="collocation intervals of the optimisations (default: 60)")
-
+    p.add_argument("--strategies", type=strategy_list, default=None, metavar="NAMES",
+                   help="comma-separated subset of baseline, nominal_optimum, robust_feedforward, closed_loop "
+                        "(default: all)")
     p.set_defaults(run=_command("robust"))
 
 

@@ -144,7 +144,8 @@ def robust(args):
     from .shiftcontrol.report import run_robust
 
     run_robust(args.scene, out_dir=args.out, samples=args.samples, seed=args.seed, uncertain=args.uncertain,
-               t_max=args.t_max, controller=args.controller, workers=args.workers, intervals=args.intervals)
+               t_max=args.t_max, controller=args.controller, workers=args.workers, intervals=args.intervals,
+               **({"strategies": args.strategies} if args.strategies else {}))
     return 0
 
 

@@ -16,8 +16,10 @@ def _label(key):
             "load.torque": "load torque [N m]"}.get(key, key)
 
 
-def plot_jump_vs_fields(out, rows, uncertainty, strategies):
-    """|jump| at lock-up against each numeric uncertain field, one panel per field; no-lock samples on top."""
+def plot_jump_vs_fields(out, rows, uncertainty, strategies, target=None):
+    """|jump| at lock-up against each numeric uncertain field, one panel per field; no-lock samples on top
+    (dashed: the closed loop's 95th-percentile target ``target`` [%], default 3 %)."""
+    target = 3.0 if target is None else target
     numeric = [s.key for s in uncertainty.spreads if s.kind != "values"]
     if not numeric:
         return []
@@ -34,7 +36,7 @@ def plot_jump_vs_fields(out, rows, uncertainty, strategies):
             miss = [r[key] for r in mine if r["jump_pct"] is None]
             if miss:
                 ax.scatter(miss, [top] * len(miss), marker="x", s=18, color=COLOURS.get(s.name))
-        ax.axhline(3.0, color="k", lw=0.8, ls="--")
+        ax.axhline(target, color="k", lw=0.8, ls="--")
         ax.set_xlabel(_label(key))
         ax.set_ylabel("|torque jump at lock-up| [% of locked torque]")
         ax.set_yscale("log")
@@ -43,12 +45,14 @@ def plot_jump_vs_fields(out, rows, uncertainty, strategies):
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside lower center", ncol=len(strategies), fontsize=8)
     fig.suptitle(f"Torque jump at lock-up over {len({r['sample'] for r in rows})} samples "
-                 f"(x at the top: no lock-up; dashed: 3 %)", fontsize=10)
+                 f"(x at the top: no lock-up; dashed: {target:g} %)", fontsize=10)
     return [save_figure(fig, out / "jump_vs_fields.png")]
 
 
-def plot_distributions(out, rows, strategies, t_max):
-    """Box plots per strategy: |jump| [% of locked torque] and engagement time [s] (with t_max)."""
+def plot_distributions(out, rows, strategies, t_max, target=None):
+    """Box plots per strategy: |jump| [% of locked torque] and engagement time [s] (with t_max); dashed: the
+    closed loop's 95th-percentile target ``target`` [%] (default 3 %)."""
+    target = 3.0 if target is None else target
     fig, (ax1, ax2) = new_figure(2, width=5.6, height=4.6)
     names = [s.name for s in strategies]
     share = {n: 100 * np.mean([r["locked_within_t_max"] for r in rows if r["strategy"] == n]) for n in names}
@@ -64,7 +68,7 @@ def plot_distributions(out, rows, strategies, t_max):
         ax.set_xticks(range(1, len(names) + 1), labels, fontsize=7)
         ax.set_ylabel(title)
         ax.grid(alpha=0.3, axis="y")
-    ax1.axhline(3.0, color="k", lw=0.8, ls="--", label="3 %")
+    ax1.axhline(target, color="k", lw=0.8, ls="--", label=f"{target:g} %")
     ax1.set_yscale("log")
     ax1.set_ylim(bottom=min(ax1.get_ylim()[0], 1.0))
     ax1.legend(fontsize=7)

@@ -22,9 +22,12 @@ import casadi as ca
 import numpy as np
 from scipy.linalg import expm
 
-from ..control.linearize import jacobian_function, linear_model
+from ..control.linearize import eliminate_algebraic, jacobian_function, linear_model
+from ..engagement.model import EngagementModel
 from ..errors import ModelError
 from ..optimal.guess import SLIP_MODE
+from ..optimal.replay import COMMAND
+from ..scene.symbolic import SymbolicScene
 
 #: Signals of the slip phase that the linearisation gives output rows for.
 SIGNALS = ("w_rel", "slip_rate", "w_in", "w_out", "p_valve")
@@ -47,7 +50,7 @@ class SlipLinearization:
         ``w_in``, ``w_out`` [rad/s], ``p_valve`` [Pa] that are states of the model.
     """
 
-    def __init__(self, engagement):
+    def __init__(self, engagement, parameters=None, differences=(), order=None):
         inputs = engagement.hybrid.u
         if "pressure_command" not in inputs:
             raise ModelError("slip linearisation: the engagement model needs a pressure-command input")
@@ -74,8 +77,19 @@ class SlipLinearization:
         if ca.depends_on(ca.vertcat(f, g, c), engagement.t):
             raise ModelError("slip linearisation: the slip mode depends on time explicitly (a pressure profile, "
                              "not a command)")
-        self._jacobians = jacobian_function("slip_jacobians", [x_all, z, u], x, z, u, f, g, c)
-        self._signals = ca.Function("slip_signals", [x_all, z, u], [c])
+        parameters = dict(parameters or {})
+        self.parameter_names = tuple(parameters)
+        p = ca.vertcat(*[symbol for symbol, _ in parameters.values()]) if parameters else ca.SX(0, 1)
+        self._p0 = np.array([value for _, value in parameters.values()], float)
+        self._jacobians = jacobian_function("slip_jacobians", [x_all, z, u, p], x, z, u, f, g, c)
+        self._signals = ca.Function("slip_signals", [x_all, z, u, p], [c])
+        self._by_parameters = ca.Function("slip_parameter_jacobians", [x_all, z, u, p],
+                                          [ca.jacobian(e, p) for e in (f, g, c)])
+        self._values = ca.Function("slip_values", [x_all, z, u, p], [f, g, c])
+        self._differences = list(differences)
+        names = self.parameter_names + tuple(d.name for d in self._differences)
+        self._order = [names.index(n) for n in (order or names)]
+        self.parameter_names = tuple(order or names)
         self.nominal = np.array([mode.x_nominal[list(mode.x).index(n)] for n in self.state_names])
 
     @property
@@ -97,13 +111,37 @@ class SlipLinearization:
         A is (n, n), B (n, 1), C (len(signals), n), D (len(signals), 1); algebraic variables eliminated.
         """
         x, z = self._point(x, z)
-        return linear_model(self._jacobians, x, z, u)
+        return linear_model(self._jacobians, x, z, u, self._p0)
 
     def signal_values(self, x, u, z=None):
         """The signals (w_rel, slip_rate, ...) at a point, SI (dict)."""
         x, z = self._point(x, z)
-        values = np.array(self._signals(x, z, u), float).ravel()
+        values = np.array(self._signals(x, z, u, self._p0), float).ravel()
         return dict(zip(self.signals, values))
+
+    def parameter_columns(self, x, u, z=None):
+        """(F, G) at a point: the response of the state rates (n, m) and of the signals (len(signals), m) to a
+        relative change of each parameter, theta_i = theta_i,nom (1 + d_i): columns theta_i,nom d(f, c)/d theta_i,
+        algebraic variables eliminated (empty with no parameters)."""
+        x, z = self._point(x, z)
+        if not self.parameter_names:
+            return np.zeros((self.n, 0)), np.zeros((len(self.signals), 0))
+        point = (x, z, u, self._p0)
+        # relative columns: theta_nom d/d theta (symbols: the Jacobian times theta_nom; differences: already so)
+        f_p, g_p, c_p = (np.array(m, float) * self._p0 for m in self._by_parameters(*point))
+        blocks = [[m] for m in (f_p, g_p, c_p)]
+        for d in self._differences:
+            for block, column in zip(blocks, d.blocks(x, z, u)):
+                block.append(column.reshape(-1, 1))
+        f_p, g_p, c_p = (np.hstack(block)[:, self._order] for block in blocks)
+        fx, fz, _, gx, gz, _, cx, cz, _ = (np.array(m, float) for m in self._jacobians(*point))
+        (_, F), (_, G) = eliminate_algebraic(gx, gz, g_p, (fx, fz, f_p), (cx, cz, c_p))
+        return F, G
+
+    def values(self, x, u, z=None):
+        """(f, g, c) at a point: state rates (n,), algebraic residuals, signals (numpy arrays)."""
+        x, z = self._point(x, z)
+        return [np.array(v, float).ravel() for v in self._values(x, z, u, self._p0)]
 
     def sample_map(self, points, u_points, dt, z_points=None):
         """(Phi, Gamma) of one sample from the trajectory at the midpoints of its m sub-intervals.
@@ -133,3 +171,64 @@ class SlipLinearization:
             E = expm(M)
             Phi, Gamma = E[:n, :n] @ Phi, E[:n, :n] @ Gamma + E[:n, n:]
         return Phi, Gamma
+
+
+DIFFERENCE_STEP = 1e-3      # relative step of the central differences for a field the model cannot take as a symbol
+
+
+class _Difference:
+    """Central differences of the slip mode's (f, g, c) in one scene field, from two models built at
+    theta_nom (1 +- h): the column of a field the engagement model cannot take as a CasADi symbol (one
+    that also sets a scale, e.g. ``driveline.input_torque`` the lock-up event's). O(h^2) accurate."""
+
+    def __init__(self, scene, name, h=DIFFERENCE_STEP):
+        self.name, self.h = name, h
+        self.nominal = float(scene.value(name))
+        self._sides = [SlipLinearization(EngagementModel(scene.with_overrides({name: self.nominal * (1 + s * h)}),
+                                                          smooth=False, pressure_command=ca.SX.sym(COMMAND)))
+                       for s in (1.0, -1.0)]
+
+    def blocks(self, x, z, u):
+        """theta_nom d(f, g, c)/d theta at fixed (x, z, u): three column vectors."""
+        plus, minus = (side.values(x, u, z) for side in self._sides)
+        return [(a - b) / (2 * self.h) for a, b in zip(plus, minus)]
+
+
+def _symbolic_model(scene, names):
+    symbolic = SymbolicScene(scene, names)
+    command = ca.SX.sym(COMMAND)
+    model = EngagementModel(symbolic, smooth=False, pressure_command=command)
+    return model, symbolic.symbols
+
+
+_SYMBOLIC_FIELDS = {}       # (scene structure, names) -> the fields the model takes as symbols
+
+
+def parametric_linearization(scene, names):
+    """The slip linearisation of ``scene`` with relative-change columns for the scene fields ``names``.
+
+    Fields the engagement model can take as CasADi symbols get exact Jacobians; the others central
+    differences (:class:`_Difference`). Returns a :class:`SlipLinearization` whose
+    :meth:`~SlipLinearization.parameter_columns` are in the order of ``names``.
+    """
+    names = tuple(names)
+    key = (scene.path, scene.name, names)
+    symbolic = _SYMBOLIC_FIELDS.get(key)
+    if symbolic is None:
+        try:
+            _symbolic_model(scene, names)
+            symbolic = names
+        except Exception:            # some field cannot be a symbol: find which, one at a time
+            symbolic = []
+            for name in names:
+                try:
+                    _symbolic_model(scene, (name,))
+                    symbolic.append(name)
+                except Exception:
+                    pass
+            symbolic = tuple(symbolic)
+        _SYMBOLIC_FIELDS[key] = symbolic
+    model, symbols = _symbolic_model(scene, symbolic)
+    parameters = {name: (symbols[name], float(scene.value(name))) for name in symbolic}
+    differences = [_Difference(scene, name) for name in names if name not in symbolic]
+    return SlipLinearization(model, parameters, differences=differences, order=names)

@@ -67,21 +67,44 @@ def run_sample(task):
     grid = np.arange(0.0, task["t_end"] + 1e-12, HISTORY_STEP)
     rows = []
     for strategy in task["strategies"]:
-        if strategy.feedback is not None:
+        if strategy.notes.get("centre_only") and task["index"] >= 0:
+            continue
+        draws = {}
+        if strategy.feedback is not None and strategy.feedback.sensors is not None:
+            schedule = strategy.feedback
+            sensors = realize_sensors(schedule, scene, model, task)
+            reading = sensors.viscosity(scene.value("oil.viscosity")) if schedule.field == "oil.viscosity" else None
+            feedback, _ = schedule.select(scene, reading)
+            run, _ = run_closed_loop(scene, feedback, task["t_end"], model=model, sensors=sensors)
+            draws = dict(sensors.draws, **({"viscosity_read_Pa_s": reading} if reading is not None else {}))
+        elif strategy.feedback is not None:
             feedback, design = strategy.feedback.select(scene)
             run, _ = run_closed_loop(scene, feedback, task["t_end"], nominal_scene=_scene(task, design) if design
                                      else nominal, model=model)
         else:
             run = run_open_loop(scene, strategy.times, strategy.values, task["t_end"], model=model)
-        rows.append(_row(task, strategy, run, grid))
+        rows.append(_row(task, strategy, run, grid, draws))
     return rows
 
 
-def _row(task, strategy, run, grid):
+def realize_sensors(schedule, scene, model, task):
+    """The sensors of one sample's transmission, drawn from the sample's own seed (the Monte Carlo seed and the
+    sample's index: the same sensors whatever the order or process the samples run in). The nominal clutch
+    (index -1) has nominal sensors: no unit errors, only the reading noise and the timer's quantisation."""
+    eng = model.engagement
+    x0 = dict(zip(eng.state_names, eng.initial_state))
+    rng = np.random.default_rng([task.get("seed", 0), task["index"] + 1])
+    sensors = schedule.sensors.nominal() if task["index"] < 0 else schedule.sensors
+    return sensors.realize(rng, {name: x0[name] for name in ("w_in", "w_out", "p_valve") if name in x0},
+                                    schedule.feedbacks[0].Ts)
+
+
+def _row(task, strategy, run, grid, draws=None):
     numbers = run_numbers(run)
     t_lock = numbers["engagement_time_s"]
     row = {"sample": task["index"], "strategy": strategy.name, **{k: float(v) if not isinstance(v, str) else v
                                                                  for k, v in task["overrides"].items()}}
+    row["sensor_draws"] = dict(draws or {})
     row.update(numbers)
     row["locked"] = t_lock is not None
     # an optimum ends exactly at t_max; IDAS locates its (tangential) lock-up within the verification's

@@ -18,11 +18,21 @@ from ..scene import default_scene, load_scene
 from ..scene.uncertainty import Uncertainty
 from .figures import plot_distributions, plot_envelopes, plot_jump_vs_fields
 from .spec import load_slip_spec
-from .workflow import COLUMNS, build_strategies, cpu_count, format_summary, monte_carlo, robust_summary
+from .export import write_commands
+from .workflow import (
+    COLUMNS,
+    STRATEGIES,
+    build_strategies,
+    check_strategies,
+    cpu_count,
+    format_summary,
+    monte_carlo,
+    robust_summary,
+)
 
 
 def run_robust(scene=None, out_dir="out/robust", *, samples=200, seed=0, uncertain=(), t_max=None,
-               controller="slip_lqr", workers=None, intervals=60, progress=True):
+               controller="slip_lqr", workers=None, intervals=60, progress=True, strategies=STRATEGIES):
     """Monte Carlo of the shift-control strategies of a scene; writes summary.json, samples.csv, figures.
 
     Parameters
@@ -45,6 +55,8 @@ def run_robust(scene=None, out_dir="out/robust", *, samples=200, seed=0, uncerta
         Processes (default: the local cores).
     intervals : int
         Collocation intervals of the optimisations.
+    strategies : sequence of str
+        Which of ``baseline``, ``nominal_optimum``, ``robust_feedforward``, ``closed_loop`` to run (default: all).
 
     Returns
     -------
@@ -61,6 +73,7 @@ def run_robust(scene=None, out_dir="out/robust", *, samples=200, seed=0, uncerta
             continue
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
             raise ModelError(f"{name} = {value!r}: must be a whole number >= 1")
+    chosen = check_strategies(strategies)
     spec = load_slip_spec(controller)
     uncertainty = Uncertainty.from_scene(scene, extra=tuple(uncertain))
     if not uncertainty:
@@ -68,7 +81,8 @@ def run_robust(scene=None, out_dir="out/robust", *, samples=200, seed=0, uncerta
                          "--uncertain \"friction.mu=uniform 10 %\"")
     nominal = scene.without_uncertainty()
     start = time.perf_counter()
-    strategies, facts = build_strategies(nominal, uncertainty, spec, t_max=t_max, intervals=intervals, say=say)
+    strategies, facts = build_strategies(nominal, uncertainty, spec, t_max=t_max, intervals=intervals, say=say,
+                                         chosen=chosen)
     setup = time.perf_counter() - start
     bar = _progress_bar(samples + 1, progress)          # the centre and the draws
     rows, t_end, mc_time, n_runs = monte_carlo(nominal, uncertainty, strategies, facts, samples=samples, seed=seed,
@@ -85,9 +99,12 @@ def run_robust(scene=None, out_dir="out/robust", *, samples=200, seed=0, uncerta
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     files = [write_summary(out / "summary.json", summary), _write_samples(out / "samples.csv", rows, uncertainty)]
-    files += plot_jump_vs_fields(out, drawn, uncertainty, strategies)
-    files.append(plot_distributions(out, drawn, strategies, t_max))
-    files.append(plot_envelopes(out, drawn, centre, strategies, t_max))
+    shown = [s for s in strategies if not s.notes.get("centre_only")]
+    target = spec.acceptance["jump_p95_pct"] if "closed_loop" in chosen else None
+    files += plot_jump_vs_fields(out, drawn, uncertainty, shown, target)
+    files.append(plot_distributions(out, drawn, shown, t_max, target))
+    files.append(plot_envelopes(out, drawn, centre, shown, t_max))
+    files += write_commands(out, strategies, facts)
     summary["files"] = [str(f) for f in files]
     if progress:
         print(format_summary(summary))
@@ -111,6 +128,9 @@ def _write_samples(path, rows, uncertainty):
     columns = {"sample": [r["sample"] for r in rows], "strategy": [r["strategy"] for r in rows]}
     for f in fields:
         columns[f] = [r.get(f) for r in rows]
+    draws = list(dict.fromkeys(k for r in rows for k in r.get("sensor_draws", {})))
+    for key in draws:
+        columns[key] = ["" if r.get("sensor_draws", {}).get(key) is None else r["sensor_draws"][key] for r in rows]
     columns["locked"] = [int(r["locked"]) for r in rows]
     columns["locked_within_t_max"] = [int(r["locked_within_t_max"]) for r in rows]
     for key, name in COLUMNS:

@@ -17,6 +17,8 @@ import numpy as np
 
 from ..errors import MissingParameterError, ModelError
 from .design import design_slip_feedback
+from .lqg import design_tcu_feedback
+from .sensors import sensors_from_spec
 
 
 @dataclass
@@ -37,6 +39,8 @@ class FeedbackSchedule:
         Lock-up time of each design's feedforward on its own scene [s].
     adaptation_off : str or None
         Why the spec's feedforward adaptation cannot run on the scene (None: it runs, or the spec has it off).
+    sensors : clutchocp.shiftcontrol.sensors.Sensors or None
+        What the TCU reads (the Kalman-filter controller; None: the difference controller reads the exact states).
     """
 
     field: str
@@ -45,6 +49,7 @@ class FeedbackSchedule:
     overrides: list
     lock_times: list
     adaptation_off: str | None = None
+    sensors: object = None
 
     def index(self, scene):
         """Index of the grid value nearest a clutch's own value of the field (0 without a schedule)."""
@@ -52,16 +57,17 @@ class FeedbackSchedule:
             return 0
         return int(np.argmin(np.abs(self.values - scene.value(self.field))))
 
-    def select(self, scene):
-        """(SlipFeedback, overrides of the scene it stands for) for a clutch ``scene``.
+    def select(self, scene, value=None):
+        """(feedback, overrides of the scene it stands for) for a clutch ``scene``.
 
-        The TCU interpolates its calibration: between two grid values the two designs are blended
-        linearly in the field (:meth:`SlipFeedback.blended`), outside the grid the end design is used,
-        and two designs that cannot be blended (different horizons) give the nearest one.
+        The TCU interpolates its calibration at its reading of the field (``value``; default: the
+        clutch's own value): between two grid values the two designs are blended linearly in the field
+        (:meth:`SlipFeedback.blended`), outside the grid the end design is used, and two designs that
+        cannot be blended (different horizons) give the nearest one.
         """
         if not self.field:
             return self.feedbacks[0], self.overrides[0]
-        value = scene.value(self.field)
+        value = scene.value(self.field) if value is None else float(value)
         upper = int(np.clip(np.searchsorted(self.values, value), 1, len(self.values) - 1))
         weight = (value - self.values[upper - 1]) / (self.values[upper] - self.values[upper - 1])
         if weight <= 0.0 or weight >= 1.0:
@@ -69,7 +75,7 @@ class FeedbackSchedule:
             return self.feedbacks[i], self.overrides[i]
         blended = self.feedbacks[upper - 1].blended(self.feedbacks[upper], weight)
         if blended is None:
-            i = self.index(scene)
+            i = int(np.argmin(np.abs(self.values - value)))
             return self.feedbacks[i], self.overrides[i]
         return blended, {self.field: float(value)}
 
@@ -118,15 +124,23 @@ def design_schedule(scene, spec, uncertainty, feedforward_for, *, say=print):
     """
     values = schedule_values(scene, spec, uncertainty)
     overrides = [{spec.schedule_field: float(v)} for v in values] or [{}]
+    kalman = spec.estimator["method"] == "kalman"
+    sensors = sensors_from_spec(spec, scene) if kalman else None
+    if sensors is not None and sensors.sump is not None and spec.schedule_field != "oil.viscosity":
+        raise ModelError("sensors.sump_temperature: the TCU reads the viscosity through it only with "
+                         "schedule.field = \"oil.viscosity\"")
     feedbacks, lock_times, adaptation_off = [], [], None
     for i, override in enumerate(overrides):
         design_scene = scene.with_overrides(override) if override else scene
         if override:
             say(f"  design {i + 1}/{len(overrides)}: {spec.schedule_field} = {values[i]:.4g}")
         times, command = feedforward_for(design_scene)
-        design = design_slip_feedback(design_scene, times, command, spec)
+        if kalman:
+            design = design_tcu_feedback(design_scene, times, command, spec, sensors)
+        else:
+            design = design_slip_feedback(design_scene, times, command, spec)
+            adaptation_off = design.adaptation_off
         feedbacks.append(design.feedback)
         lock_times.append(float(design.t_lock))
-        adaptation_off = design.adaptation_off
     return FeedbackSchedule(spec.schedule_field if values else "", np.asarray(values, float) if values
-                            else np.array([np.nan]), feedbacks, overrides, lock_times, adaptation_off)
+                            else np.array([np.nan]), feedbacks, overrides, lock_times, adaptation_off, sensors)

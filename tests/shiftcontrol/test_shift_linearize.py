@@ -83,3 +83,39 @@ def test_sample_map_matches_finite_differences_of_the_idas_sample(setup):
         lin_col = sum(Phi[:, lin.state_names.index(n)] for n in names)
         rows = [i for i, n in enumerate(lin.state_names) if n != "p_valve" or names == ["p_valve"]]
         np.testing.assert_allclose(lin_col[rows], fd[rows], rtol=5e-3, atol=1e-3 * np.max(np.abs(fd[rows])))
+
+
+def test_parameter_columns_exact_against_differences_and_closed_form(setup):
+    """Relative-change columns of the slip dynamics: the exact ones (fields as CasADi symbols) against central
+    differences of two models; the engine torque (a field the model cannot take as a symbol) against Newton's
+    law for the input rotor, theta d(dw_in/dt)/d theta = T_in / J_in, and the same in the slip rate."""
+    from clutchocp.shiftcontrol.linearize import _Difference, parametric_linearization
+
+    scene, model, lin, times, values, state_at, _ = setup
+    names = ("friction.mu", "load.torque", "driveline.input_torque", "actuation.time_constant")
+    plin = parametric_linearization(scene, names)
+    assert plin.parameter_names == names
+    x0, u0 = state_at(T0), float(np.interp(T0, times, values))
+    F, G = plin.parameter_columns(x0, u0)
+    # the state Jacobians are the concrete model's
+    np.testing.assert_allclose(plin.continuous(x0, u0)[0], lin.continuous(x0, u0)[0], rtol=1e-12, atol=1e-9)
+    for j, name in enumerate(("friction.mu", "load.torque", "actuation.time_constant")):
+        f_d, _, c_d = _Difference(scene, name, h=1e-4).blocks(x0, np.zeros(0), u0)
+        col = names.index(name)
+        np.testing.assert_allclose(F[:, col], f_d, rtol=1e-6, atol=1e-8 * np.max(np.abs(f_d)))
+        np.testing.assert_allclose(G[:, col], c_d, rtol=1e-6, atol=1e-8 * np.max(np.abs(c_d)))
+    T_in, J_in = scene.value("driveline.input_torque"), scene.value("driveline.input_inertia")
+    T_L, J_out = scene.value("load.torque"), scene.value("driveline.output_inertia")
+    i_in, i_out = plin.state_names.index("w_in"), plin.state_names.index("w_out")
+    col = names.index("driveline.input_torque")
+    assert F[i_in, col] == pytest.approx(T_in / J_in, rel=1e-9)
+    assert np.delete(F[:, col], i_in) == pytest.approx(0.0, abs=1e-9)
+    assert G[plin.signals.index("slip_rate"), col] == pytest.approx(T_in / J_in, rel=1e-9)
+    load = names.index("load.torque")
+    assert F[i_out, load] == pytest.approx(-T_L / J_out, rel=1e-12)
+    assert G[plin.signals.index("slip_rate"), load] == pytest.approx(T_L / J_out, rel=1e-12)
+    # the valve lag: d(dp/dt) = -(u - p) / tau x d (relative change of tau)
+    i_p = plin.state_names.index("p_valve")
+    p = x0[plin.all_states.index("p_valve")]
+    tau = scene.value("actuation.time_constant")
+    assert F[i_p, names.index("actuation.time_constant")] == pytest.approx(-(u0 - p) / tau, rel=1e-12)

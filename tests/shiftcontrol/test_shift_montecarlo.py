@@ -152,3 +152,28 @@ def test_closed_loop_is_scheduled_on_the_oil_viscosity(monkeypatch):
     assert schedule_values(nominal, replace(spec, schedule_points=1), Uncertainty.from_scene(scene)) == []
     with pytest.raises(SceneError, match=r"schedule\.field = 'oil\.viscosty': the scene 'default_driveline' has no"):
         schedule_values(nominal, replace(spec, schedule_field="oil.viscosty"), Uncertainty.from_scene(scene))
+
+
+def test_a_subset_of_strategies_skips_the_robust_feedforward(monkeypatch):
+    """--strategies closed_loop: no robust solve (it would fail the test), the nominal optimum solved and run on the
+    nominal clutch alone (its jerk is the closed loop's yardstick), the closed loop on every draw."""
+    from dataclasses import replace
+
+    from clutchocp.errors import ModelError
+    from clutchocp.shiftcontrol import workflow
+    from clutchocp.shiftcontrol.spec import load_slip_spec
+
+    def solve(*args, **kwargs):
+        raise AssertionError("the robust feedforward was solved although not asked for")
+
+    monkeypatch.setattr(workflow, "robust_solver", lambda: (solve, lambda scene, corners: []))
+    scene = default_scene()
+    spec = replace(load_slip_spec(), schedule_field="")
+    strategies, facts = workflow.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene), spec,
+                                                intervals=30, say=lambda *a: None, chosen=("closed_loop",))
+    assert [s.name for s in strategies] == ["nominal_optimum", "closed_loop"]
+    assert strategies[0].notes["centre_only"] and not strategies[1].notes.get("centre_only")
+    assert facts["robust_feedforward"] == "not asked for (--strategies)"
+    with pytest.raises(ModelError, match="--strategies open_loop: allowed are baseline"):
+        workflow.check_strategies(("open_loop",))
+    assert workflow.check_strategies(("closed_loop", "baseline")) == ("baseline", "closed_loop")

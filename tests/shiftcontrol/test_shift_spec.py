@@ -7,6 +7,19 @@ from clutchocp.errors import SceneError
 from clutchocp.shiftcontrol.spec import load_slip_spec, parse_slip_spec
 
 GOOD = {"controller": {"type": "slip_lqi", "sample_time": "10 ms"}}
+KALMAN = {"controller": {**GOOD["controller"], "progress": "time"}, "estimator": {"enabled": True, "method": "kalman"}}
+
+
+def test_tcu_spec_loads_its_sensors():
+    spec = load_slip_spec("slip_lqr_tcu")
+    assert spec.estimator["method"] == "kalman" and spec.progress == "time"
+    speed = spec.sensors["input_speed"]
+    assert (speed["method"], speed["teeth"], speed["timer_resolution"], speed["pitch_error"]) == \
+        ("edge_timing", 60, pytest.approx(1e-6), pytest.approx(0.005))
+    assert spec.sensors["sump_temperature"]["error_C"] == 3.0
+    assert spec.sensors["sump_temperature"]["oil_viscosity_40C"] == pytest.approx(80.12e-6)
+    assert spec.estimated_parameters["driveline.input_torque"] == pytest.approx(0.05)
+    assert spec.acceptance == {"lock_by_t_max": 1.03, "jump_p95_pct": 5.0, "jump_worst_pct": 10.0, "jerk_ratio": 1.15}
 
 
 def test_builtin_spec_loads_with_units():
@@ -16,7 +29,9 @@ def test_builtin_spec_loads_with_units():
     assert spec.anti_windup == "clamping" and spec.progress == "time"
     assert spec.lqi["slip_tolerance"] == pytest.approx(0.03)
     assert spec.t_max_fraction == pytest.approx(0.98)
-    assert spec.estimator == {"enabled": True, "activation": 0.5, "gain_limit": 1.5}
+    assert {k: spec.estimator[k] for k in ("enabled", "method", "activation", "gain_limit")} == \
+        {"enabled": True, "method": "difference", "activation": 0.5, "gain_limit": 1.5}
+    assert spec.sensors == {} and spec.valve == {"dead_time": 0.0, "assumed_dead_time": 0.0}
     assert (spec.schedule_field, spec.schedule_points) == ("oil.viscosity", 5)
     bare = parse_slip_spec(GOOD)            # without the tables: no estimator, no schedule
     assert not bare.estimator["enabled"] and bare.schedule_field == "" and bare.schedule_points == 1
@@ -51,6 +66,18 @@ def test_builtin_spec_loads_with_units():
     ({**GOOD, "schedule": {"field": "oil.viscosity"}, "feedforward": {"curve": "robust"}},
      r"schedule\.field = 'oil\.viscosity' needs feedforward\.curve = \"nominal\""),
     ({**GOOD, "schedule": {"feild": "oil.viscosity"}}, r"schedule\.feild: unknown key .*did you mean 'field'"),
+    ({**GOOD, "sensors": {"input_speed": {"method": "hall"}}}, r"sensors\.input_speed\.method = 'hall': allowed values"),
+    ({**GOOD, "sensors": {"wheel_speed": {}}}, r"\[wheel_speed\]: unknown table"),
+    ({**KALMAN, "sensors": {"input_speed": {"teeth": 2.5}}},
+     r"sensors\.input_speed\.teeth = 2\.5: must be a whole number"),
+    ({**GOOD, "sensors": {"pressure": {"noise": "5 kPa"}}}, r"\[sensors\] and \[valve\] need estimator\.method"),
+    ({**KALMAN, "estimator": {"enabled": True, "method": "kalman", "parameters": {"friction.mu": "150 %"}}},
+     r"estimator\.parameters\.\"friction\.mu\" = '150 %': the prior half-width must be below 100 %"),
+    ({**KALMAN, "valve": {"dead_time": "20 ms"}},
+     r"valve\.dead_time = 0\.02 s: must be below controller\.sample_time"),
+    ({"controller": {**GOOD["controller"], "progress": "slip"}, "estimator": {"enabled": True, "method": "kalman"}},
+     r"estimator\.method = \"kalman\" needs controller\.progress = \"time\""),
+    ({**GOOD, "acceptance": {"lock_by_t_max": 0.9}}, r"acceptance\.lock_by_t_max = 0\.9: must be >= 1"),
 ])
 def test_bad_specs_raise_one_line(raw, match):
     with pytest.raises(SceneError, match=match) as info:
@@ -64,6 +91,7 @@ def test_bad_specs_raise_one_line(raw, match):
     (["robust", "--uncertain", "friction.mu=uniform ten %"], "friction.mu"),
     (["robust", "--uncertain", "friction.nu=uniform 10 %"], "friction.nu"),
     (["robust", "--controller", "no_such_spec"], "no_such_spec"),
+    (["robust", "--strategies", "closed_loop,open_loop"], "--strategies: 'closed_loop,open_loop': a comma-separated"),
 ])
 def test_robust_command_bad_input_exits_2_with_one_line(argv, match, capsys, tmp_path):
     code = main(argv + ["--out", str(tmp_path / "out")])

@@ -1,6 +1,7 @@
 """Every number the documentation quotes, measured by running the tool, and written into the docs.
 
-Run from the repository root (about 8-10 minutes on two idle cores; the items run two at a time)::
+Run from the repository root (the items run two at a time; 10 minutes of CPU in all, so about
+6-10 minutes on two idle cores; 35 minutes measured with the machine's load average at 8-10)::
 
     python benchmarks/docs_numbers.py                  # measure every item, update the JSON, rewrite the docs
     python benchmarks/docs_numbers.py --only optimize_default,readme_example
@@ -22,6 +23,13 @@ renders from the committed JSON, that the cheap numbers re-computed live agree w
 every summary.json key and CSV column the commands wrote here (``keys`` of each item) is documented
 on the command's page. After a change that moves results, run this script and commit the JSON and
 the docs together.
+
+Adding a number to a page: write an item (a function of a scratch folder that runs the command or
+script and returns the values, JSON-ready; add it to ``ITEMS``, ``ORDER`` and, if it writes a
+command's folder, its ``keys`` to ``KEYS_OF``), a renderer of those values (add it to
+``RENDERERS``), and put ``<!-- generated: NAME -->`` / ``<!-- end generated -->`` where the page
+shows it. A benchmark that writes its own JSON (e.g. ``--json FILE``) becomes an item that runs it
+and reads that file. Run the item with ``--only NAME``.
 """
 
 import argparse

@@ -25,6 +25,7 @@ import numpy as np
 
 from . import interrupt
 from .errors import ModelError, OutputFolderError
+from .plotting import finish
 
 MARKER = ".clutchocp-result"   # written into every completed output folder
 _ACTIVE = {}                   # temporary folder being written -> the target as the user wrote it
@@ -293,8 +294,10 @@ def new_figure(n_panels=1, width=6.4, height=4.2):
 
 
 def save_figure(fig, path):
-    """Save a figure as PNG (100 dpi) and return its path."""
+    """Save a figure as PNG (100 dpi) and return its path, with the shared conventions of
+    :func:`clutchocp.plotting.finish` (plain tick labels, legends outside the data, wrapped titles)."""
     path = Path(path)
+    finish(fig)
     fig.savefig(path, dpi=100)
     return path
 

@@ -299,10 +299,15 @@ def write_rows(path, rows, columns=SWEEP_COLUMNS):
 
 
 def plot_work_precision(results, path, floors=None):
-    """Error against wall time (log-log), one panel per scene, one curve per method; with
-    ``floors`` (``{scene: rows of clutchocp.bench.floor.integrator_floor}``) the integrator
-    floor of each method as a dashed curve of the same colour."""
-    fig, axes = new_figure(len(results), width=5.2, height=4.2)
+    """Error against wall time (log-log), one panel per scene (three to a row), one curve per method;
+    with ``floors`` (``{scene: rows of clutchocp.bench.floor.integrator_floor}``) the integrator
+    floor of each method as a dashed curve of the same colour. One legend for all panels."""
+    cols = min(3, len(results))
+    rows = -(-len(results) // cols)
+    fig, _ = new_figure(cols, width=4.6, height=3.6 * rows)
+    fig.clear()                      # new_figure lays its panels in one row; this one is a grid
+    axes = [fig.add_subplot(rows, cols, k + 1) for k in range(len(results))]
+    handles = {}
     for ax, res in zip(axes, results):
         methods = list(dict.fromkeys(r["method"] for r in res["rows"]))
         floor_rows = (floors or {}).get(res["scene"], [])
@@ -311,12 +316,17 @@ def plot_work_precision(results, path, floors=None):
             if pts:
                 e, w = zip(*pts)
                 line, = ax.loglog(e, np.array(w) * 1e3, "o-", ms=4, label=method)
+                handles.setdefault(method, line)
                 low = sorted(points_of(floor_rows, method, key="time_s"))
                 if low:
                     e, w = zip(*low)
-                    ax.loglog(e, np.array(w) * 1e3, "x--", ms=4, color=line.get_color(), label=f"{method} floor")
+                    floor, = ax.loglog(e, np.array(w) * 1e3, "x--", ms=4, color=line.get_color(),
+                                       label=f"{method} floor")
+                    handles.setdefault(f"{method} floor", floor)
         ax.axvspan(min(ERROR_LEVELS), 1e-4, color="0.93", zorder=0)
-        ax.set(xlabel="error (speeds, gaps, lock time, torque jump) [relative]", ylabel="wall time [ms]",
-               title=f"{res['scene']}: work-precision")
-        ax.legend(fontsize=7)
+        ax.set(xlabel="error [relative]", ylabel="wall time [ms]", title=res["scene"])
+        ax.grid(alpha=0.3, which="both")
+    fig.legend(list(handles.values()), list(handles), loc="outside right upper", fontsize=8)
+    fig.suptitle("Work-precision: wall time against the error of speeds, gaps, lock time and torque jump "
+                 "(grey: the matched error levels; dashed: the integrator floor)", fontsize=10)
     return save_figure(fig, path)

@@ -9,7 +9,7 @@ starts every cycle from the scene's speeds, as on an inertia test bench that re-
 flywheels between engagements.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +17,7 @@ from matplotlib.ticker import MaxNLocator
 
 from ..errors import ModelError, SolverError
 from ..output import new_figure, save_figure, write_csv, write_summary
+from ..plotting import flat_value, overrides_of, scene_title
 from .model import EngagementModel
 from .run import simulate_engagement
 
@@ -37,6 +38,7 @@ class CyclesResult:
     max_temperature_C: float | None
     run_time_s: float
     oil_temperature_C: float
+    overrides: dict = field(default_factory=dict)       # the scene values that differ from its file (titles)
 
     def summary(self):
         """JSON-ready summary (units in the key names)."""
@@ -120,7 +122,7 @@ def run_cycles(scene, *, cycles=10, cooling_time=10.0, max_temperature_C=None, p
             reason = "temperature limit"
             break
     return CyclesResult(scene.name, rows, reason, float(cooling_time), max_temperature_C,
-                        scene.value("simulation.t_end"), part.T_oil)
+                        scene.value("simulation.t_end"), part.T_oil, overrides_of(scene))
 
 
 def write_cycles(result, out_dir):
@@ -155,10 +157,14 @@ def plot_cycles(result, path):
     for c in locked:
         slow.annotate(str(c["cycle"]), (c["start_interface_temperature_C"], c["engagement_time_s"]),
                       textcoords="offset points", xytext=(4, -10), fontsize=8)
+    drift = result.summary()["engagement_time_drift_s"] or 0.0
+    times = [c["engagement_time_s"] for c in locked]
+    drift_text = (f"no drift beyond round-off ({drift:+.1e} s)" if flat_value(times) is not None or drift == 0.0
+                  else f"engagement time drift {drift:+.4g} s")
     slow.set(xlabel="interface temperature at the start of the engagement [degC]",
-             ylabel="engagement (lock-up) time [s]",
-             title=f"engagement time drift {result.summary()['engagement_time_drift_s'] or 0:+.4g} s (labels: cycle)")
-    fig.suptitle(f"{result.scene}: {len(n)} repeated engagements, stopped by: {result.stop_reason}")
+             ylabel="engagement (lock-up) time [s]", title=f"{drift_text} (labels: cycle)")
+    fig.suptitle(scene_title(result.scene, f"{len(n)} repeated engagements, stopped by: {result.stop_reason}",
+                             result.overrides))
     return save_figure(fig, path)
 
 

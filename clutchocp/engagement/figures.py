@@ -6,6 +6,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..output import new_figure, save_figure
+from ..plotting import finish, scene_title
 from .measures import pressure_rise_time
 
 
@@ -37,7 +38,7 @@ def _early_window(t, values, fraction=0.99):
 
 def plot_engagement(run, out):
     """Gaps, speeds, torque components and pressure against time, one PNG each."""
-    res, model, name = run.result, run.model, run.summary["scene"]
+    res, model = run.result, run.model
     t = res.t
     files = []
 
@@ -51,32 +52,33 @@ def plot_engagement(run, out):
         ax_.set_yscale("log")
         ax_.grid(alpha=0.3, which="both")
     ax0.set(xlabel="time [s]", ylabel="film thickness [um]", xlim=(t[0], t_early),
-            title=f"{name}: oil films, first {t_early:.3g} s")
+            title=f"the first {t_early:.3g} s")
     ax.set(xlabel="time [s]", ylabel="film thickness [um]", title="whole run")
+    fig.suptitle(scene_title(model.scene, "oil films"))
     _mark_lockup(ax0, run)
-    ax0.legend(fontsize=8)
     files.append(_finish(fig, ax, run, out / "gaps.png"))
 
     fig, (ax,) = new_figure()
     ax.plot(t, res["w_in_rad_s"], label="input")
     ax.plot(t, res["w_out_rad_s"], label="output")
-    ax.set(xlabel="time [s]", ylabel="speed [rad/s]", title=f"{name}: speeds")
+    ax.set(xlabel="time [s]", ylabel="speed [rad/s]", title=scene_title(model.scene, "speeds"))
     files.append(_finish(fig, ax, run, out / "speeds.png"))
 
     fig, (ax,) = new_figure()
     ax.plot(t, res["viscous_torque_Nm"], label="viscous")
     ax.plot(t, res["contact_torque_Nm"], label="asperity contact")
     ax.plot(t, res["total_torque_Nm"], "k", lw=1.5, label="total")
-    ax.set(xlabel="time [s]", ylabel="clutch torque [N m]", title=f"{name}: torque components")
+    ax.set(xlabel="time [s]", ylabel="clutch torque [N m]", title=scene_title(model.scene, "torque components"))
     files.append(_finish(fig, ax, run, out / "torque.png"))
 
     # pressure and the force that presses the pack: for a spring-applied clutch the pressure
     # (the release pressure) may stay zero while the springs press the plates
     fig, (ax0, ax) = new_figure(2, width=5.0)
     ax0.plot(t, res["pressure_Pa"] / 1e6, label="pressure")
-    ax0.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{name}: actuation pressure")
+    ax0.set(xlabel="time [s]", ylabel="pressure [MPa]", title="actuation pressure")
     if model.piston.spring_applied:
-        ax0.set_title(f"{name}: release pressure (spring-applied piston)")
+        ax0.set_title("release pressure (spring-applied piston)")
+    fig.suptitle(scene_title(model.scene, "pressure and the force on the plates"))
     if not np.any(res["pressure_Pa"]):
         ax0.text(0.5, 0.6, "the pressure stays 0:\nthe springs engage the clutch\n(force: right panel)",
                  transform=ax0.transAxes, ha="center", fontsize=9)
@@ -123,7 +125,7 @@ def plot_torque_response(run, path):
     ax.set_zorder(pressure_axis.get_zorder() + 1)      # torques and legend above the pressure curve
     ax.patch.set_visible(False)
     ax.set(xlabel="time [s]", ylabel="clutch torque [N m]",
-           title=f"{model.scene.name}: torque response from 50 % pressure")
+           title=scene_title(model.scene, "torque response from 50 % pressure"))
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.12, 1.0), borderaxespad=0)
     return save_figure(fig, path)
 
@@ -142,7 +144,7 @@ def plot_heat(run, path, *, max_temperature_C=None, max_specific_power_W_mm2=Non
     ax.set(xlabel="time [s]", ylabel="specific power [W/mm^2]",
            title=f"specific energy {summary['specific_energy_J_mm2']:.3g} J/mm^2\n"
                  f"over {summary['friction_area_mm2']:.0f} mm^2 of friction area")
-    fig.suptitle(f"{summary['scene']}: heat of {what} at the friction interfaces")
+    fig.suptitle(scene_title(model.scene, f"heat of {what} at the friction interfaces"))
     if model.thermal.present:
         hot = axes[0]
         hot.plot(t, res["interface_temperature_C"], "k", lw=1.5, label="interface: lining surface, separator")
@@ -170,14 +172,15 @@ def overview_figure(run):
     -------
     matplotlib.figure.Figure
     """
-    res, model, name = run.result, run.model, run.summary["scene"]
+    res, model = run.result, run.model
     t = res.t
     fig = Figure(figsize=(11.0, 7.0), layout="constrained")
     FigureCanvasAgg(fig)
     axes = [fig.add_subplot(2, 2, k + 1) for k in range(4)]
     for i in range(model.n):
         axes[0].plot(t, res[f"h_{i + 1}_m"] * 1e6, label=f"film {i + 1}")
-    axes[0].set(ylabel="film thickness [um]", yscale="log", title=f"{name}: oil films")
+    axes[0].set(ylabel="film thickness [um]", yscale="log", title="oil films")
+    fig.suptitle(scene_title(model.scene, "engagement"))
     axes[1].plot(t, res["w_in_rad_s"], label="input")
     axes[1].plot(t, res["w_out_rad_s"], label="output")
     axes[1].set(ylabel="speed [rad/s]", title="speeds")
@@ -192,4 +195,4 @@ def overview_figure(run):
         ax.grid(alpha=0.3)
         _mark_lockup(ax, run)
         ax.legend(fontsize=7)
-    return fig
+    return finish(fig)

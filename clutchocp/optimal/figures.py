@@ -8,8 +8,10 @@ import numpy as np
 
 from ..errors import ModelError
 from ..output import new_figure, save_figure
+from ..plotting import clip_spike, finish, scene_title
 from .bound import jerk_lower_bound
 from .outcome import format_quantity
+from .verify import output_held
 
 
 def result_figure(result):
@@ -28,37 +30,96 @@ def _slip(run):
 def plot_optimum(out, scene, opt, replay, baseline, baselines, summary, curve=None, clamp_run=None):
     """Pressure, torque, speeds and jerk of the optimum (IDAS replay) against the baseline; baselines bar chart."""
     files = []
-    name = scene.name
     runs = (("optimal (IDAS replay)", replay, "C0"), (f"baseline ({summary['baseline']['profile']})", baseline, "C3"))
     files.append(save_figure(pressure_figure(scene, opt, replay, baseline, summary, curve, clamp_run),
                              out / "pressure.png"))
 
-    for key, ylabel, fname, title in (("total_torque_Nm", "clutch torque [N m]", "torque.png", "clutch torque"),
-                                      ("output_jerk_rad_s3", "output jerk [rad/s^3]", "jerk.png", "output jerk")):
-        fig, (ax,) = new_figure()
-        for label, run, color in runs:
-            t, slip = _slip(run)
-            values = run.result[key]
-            ax.plot(t if key != "output_jerk_rad_s3" else t[slip],
-                    values if key != "output_jerk_rad_s3" else values[slip], color=color, label=label)
-        ax.set(xlabel="time [s]", ylabel=ylabel, title=f"{name}: {title}")
-        _locks(ax, runs)
-        ax.legend(fontsize=8)
-        files.append(save_figure(fig, out / fname))
+    fig, (ax,) = new_figure()
+    for label, run, color in runs:
+        ax.plot(run.result.t, run.result["total_torque_Nm"], color=color, label=label)
+    ax.set(xlabel="time [s]", ylabel="clutch torque [N m]", title=scene_title(scene, "clutch torque"))
+    _locks(ax, runs)
+    ax.legend(fontsize=8)
+    files.append(save_figure(fig, out / "torque.png"))
+    files.append(save_figure(jerk_figure(scene, runs), out / "jerk.png"))
 
     fig, (ax,) = new_figure()
     for label, run, color in runs:
         ax.plot(run.result.t, run.result["w_in_rad_s"], color=color, label=f"{label}: input")
         ax.plot(run.result.t, run.result["w_out_rad_s"], color=color, ls="--", label=f"{label}: output")
-    ax.set(xlabel="time [s]", ylabel="speed [rad/s]", title=f"{name}: speeds")
+    ax.set(xlabel="time [s]", ylabel="speed [rad/s]", title=scene_title(scene, "speeds"))
     _locks(ax, runs)
     ax.legend(fontsize=7)
     files.append(save_figure(fig, out / "speeds.png"))
 
     w_rel0, rate0 = summary["initial_slip_rad_s"], summary["initial_slip_rate_rad_s2"]
     share = summary["jerk_lower_bound"] / summary["slip_jerk_lower_bound"] if summary["slip_jerk_lower_bound"] else 0.0
-    files.append(plot_baselines(out, name, summary, baselines, lambda T: jerk_lower_bound(w_rel0, rate0, T) * share))
+    files.append(plot_baselines(out, scene_title(scene, "jerk against engagement time"), summary, baselines,
+                                lambda T: jerk_lower_bound(w_rel0, rate0, T) * share))
     return files
+
+
+def jerk_figure(scene, runs):
+    """The jerk of each run over its slip phase (the fill and the slip, up to lock-up).
+
+    The jerk that matters is the driven side's: the output's, or for a brake (output held, w_out = 0
+    throughout) the braked input's, -dT/dt / I_in (as the optimiser's jerk term and its IDAS check
+    take it, :func:`clutchocp.optimal.verify.run_numbers`). The axis is scaled to the slip phase:
+    the jump of the jerk when the piston meets the pack (the kiss, a fraction of a millisecond) is
+    annotated with its size instead of setting the scale. Where the first tenth of the engagement
+    holds jerk five times larger than the rest (the pressure rise of a long brake engagement), a
+    second panel shows the rest on its own scale.
+    """
+    series = [(label, color) + _jerk(scene, run) for label, run, color in runs]
+    # the squeeze films stop the piston within ~0.1 ms of the kiss; 2 % of the engagement covers it
+    t_end = max((t[-1] for _, _, t, _, _ in series if t.size), default=1.0)
+    kisses = [[e.t for e in run.result.events if e.name == "impact"][:1] for _, run, _ in runs]
+    windows = [(k[0], k[0] + 0.02 * t_end) if k else None for k in kisses]
+
+    def outside(t, window):
+        return np.ones(t.size, bool) if window is None else (t < window[0]) | (t > window[1])
+
+    split = 0.1 * t_end
+    early = max(np.max(np.abs(j[(t <= split) & outside(t, w)]), initial=0.0)
+                for (_, _, t, j, _), w in zip(series, windows))
+    late = max(np.max(np.abs(j[t > split]), initial=0.0) for _, _, t, j, _ in series)
+    fig, axes = new_figure(2 if early > 5 * late > 0 else 1, width=5.0 if early > 5 * late > 0 else 6.4)
+    held = any(h for *_, h in series)
+    side = "input" if held else "output"
+    for ax in axes:
+        for label, color, t, jerk, _ in series:
+            ax.plot(t, jerk, color=color, label=label)
+        ax.set(xlabel="time [s]", ylabel=f"{side} jerk [rad/s^3]")
+        ax.grid(alpha=0.3)
+    for (label, _, t, jerk, _), window in zip(series, windows):
+        if window is not None and t.size:
+            clip_spike(axes[0], t, jerk, window, what=f"kiss ({label.split(' (')[0]})", unit="rad/s^3")
+    what = "input jerk (a brake: the output is held)" if held else "output jerk"
+    _locks(axes[0], runs)
+    if len(axes) == 1:
+        axes[0].set_title(scene_title(scene, f"{what} up to lock-up"))
+    else:
+        fig.suptitle(scene_title(scene, f"{what} up to lock-up"))
+        axes[0].set_title("the whole engagement")
+        rest = [j[t > split] for _, _, t, j, _ in series]
+        lo, hi = min(r.min() for r in rest if r.size), max(r.max() for r in rest if r.size)
+        pad = 0.08 * (hi - lo or 1.0)
+        axes[1].set(ylim=(lo - pad, hi + pad), title=f"after the first {split:.3g} s, on its own scale")
+        _locks(axes[1], runs)
+        axes[1].set_xlim(split, 1.05 * t_end)
+    axes[-1].legend(fontsize=8)
+    return fig
+
+
+def _jerk(scene, run):
+    """(times [s], jerk [rad/s^3], output held?) of a run over its fill and slip phases."""
+    t, slip = _slip(run)
+    if output_held(run.model):     # one sample per time (an event repeats its time), then -dT/dt / I_in
+        ts, first = np.unique(t[slip], return_index=True)
+        torque = run.result["total_torque_Nm"][slip][first]
+        jerk = -np.gradient(torque, ts) / scene.value("driveline.input_inertia") if ts.size > 1 else 0 * ts
+        return ts, jerk, True
+    return t[slip], run.result["output_jerk_rad_s3"][slip], False
 
 
 def pressure_figure(scene, opt, replay, baseline, summary, curve=None, clamp_run=None):
@@ -86,13 +147,13 @@ def pressure_figure(scene, opt, replay, baseline, summary, curve=None, clamp_run
             p = np.concatenate([p[run.result.t <= t_lock], clamp_run.result["pressure_Pa"][clamp_run.result.t > t_lock]])
         ax.plot(t, p / 1e6, color=color, label=label)
     ax.plot(opt.t, opt.outputs["pressure_Pa"] / 1e6, ".", color="C0", ms=2, label="collocation")
-    ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=f"{scene.name}: engagement pressure")
+    ax.set(xlabel="time [s]", ylabel="pressure [MPa]", title=scene_title(scene, "engagement pressure"))
     _locks(ax, runs)
     ax.legend(fontsize=8)
-    return fig
+    return finish(fig)
 
 
-def plot_baselines(out, name, summary, baselines, bound_at):
+def plot_baselines(out, title, summary, baselines, bound_at):
     """baselines.png: lock-up jumps, and jerk integrals against engagement time with the kinematic bound.
 
     ``bound_at(T)``: the kinematic lower bound of the output jerk integral for engagement time T [s].
@@ -129,7 +190,7 @@ def plot_baselines(out, name, summary, baselines, bound_at):
         ax2.plot([], [], "o", color="C3", label="baseline profiles")
         ax2.legend(fontsize=7)
     ax2.set(xlabel="engagement (lock-up) time [s]", ylabel="int jerk^2 dt, slip phase [rad^2/s^5]", yscale="log",
-            title=f"{name}: jerk against engagement time")
+            title=title)
     ax2.grid(alpha=0.3, which="both")
     return save_figure(fig, out / "baselines.png")
 
@@ -154,7 +215,7 @@ def plot_piston(out, scene, replay, baseline):
     if travel > 0:
         ax1.axhline(travel * 1e3, color="k", lw=0.8, ls=":", label="kiss point (pack reached)")
     # the stroke takes milliseconds: show it up to 4 x the later kiss (dotted lines)
-    ax1.set(xlabel="time [ms]", ylabel="piston travel [mm]", title=f"{scene.name}: piston stroke to the kiss point",
+    ax1.set(xlabel="time [ms]", ylabel="piston travel [mm]", title=scene_title(scene, "piston stroke to the kiss point"),
             xlim=(0, (4 * max(kisses) if kisses else t_end) * 1e3))
     ax2.set(xlabel="time [ms]", ylabel="force [N]", title="spring force and hydraulic force", xlim=(0, t_end * 1e3))
     ax1.legend(fontsize=7)
@@ -188,13 +249,14 @@ def plot_fill_comparison(out, scene, fill):
                 ax.axvline(t_lock, color=color, lw=0.8, ls=":")
     axes[2].axhline(cap, color="k", lw=0.8, ls="--", label="peak-jerk limit (both)")
     times = [run.summary["engagement_time_s"] for _, run, _ in runs]
-    fig.suptitle(f"Minimum-time optimum against the tuned fill pulse at equal peak jerk ({cap:.4g} rad/s^3, both "
+    fig.suptitle(scene_title(scene, "minimum-time optimum against the tuned fill pulse")
+                 + f" at equal peak jerk ({cap:.4g} rad/s^3, both "
                  f"IDAS): lock-up at {format_quantity(times[0], 's')} against {format_quantity(times[1], 's')}", fontsize=10)
     axes[2].axhline(-cap, color="k", lw=0.8, ls="--")
     t_end = 1.2 * max(run.summary["engagement_time_s"] or run.result.t[-1] for _, run, _ in runs)
     for ax, ylabel, title in zip(axes, ("valve pressure [MPa]", "clutch torque [N m]", "output jerk [rad/s^3]"),
                                  ("pressure", "torque (dotted: lock-up)", "jerk up to lock-up")):
-        ax.set(xlabel="time [s]", ylabel=ylabel, title=f"{scene.name}: {title}", xlim=(0, t_end))
+        ax.set(xlabel="time [s]", ylabel=ylabel, title=title, xlim=(0, t_end))
         ax.legend(fontsize=7)
     return save_figure(fig, out / "fill_comparison.png")
 
@@ -223,6 +285,6 @@ def plot_pareto(out, scene, sweep, w_rel0, rate0, ocp):
     ax.plot(grid, [jerk_lower_bound(w_rel0, rate0, T) * share**2 for T in grid], "k--", lw=0.8,
             label="kinematic lower bound")
     ax.set(xlabel="engagement time [s]", ylabel="int jerk^2 dt [rad^2/s^5]", yscale="log",
-           title=f"{scene.name}: jerk against engagement time")
+           title=scene_title(scene, "jerk against engagement time"))
     ax.legend(fontsize=8)
     return save_figure(fig, out / "pareto.png")

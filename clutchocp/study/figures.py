@@ -8,6 +8,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..output import save_figure
+from ..plotting import flat_value, scene_title, ticks_at
 from ..scene.schema import PARTS
 from .folder import CALIBRATION, read_complete
 
@@ -59,8 +60,25 @@ def _values(rows, column):
 
 def _title(scene, task, rows):
     n_failed = sum(r["status"] != "ok" for r in rows)
-    failed = f", {n_failed} failed (not drawn)" if n_failed else ""
-    return f"{scene.name}: {task.kind} sweep, {len(rows)} points{failed}"
+    failed = f", {n_failed} failed (marked x)" if n_failed else ""
+    return scene_title(scene.name, f"{task.kind} sweep, {len(rows)} points{failed}", task.base_overrides)
+
+
+def _failed(rows):
+    """True where a point failed (its row has a reason and no results)."""
+    return np.array([r["status"] != "ok" for r in rows])
+
+
+def _constant_note(ax, values, column):
+    """State on ``ax`` that a result is the same at every point to round-off; True if it is."""
+    value = flat_value(values)
+    if value is None:
+        return False
+    finite = values[np.isfinite(values)]
+    ax.text(0.5, 0.5, f"{result_label(column)}\nthe same at every point: {value:.8g}\n(spread "
+                      f"{finite.max() - finite.min():.2g}: round-off)", transform=ax.transAxes, ha="center",
+            va="center", fontsize=8, bbox={"boxstyle": "round", "fc": "white", "ec": "0.7"})
+    return True
 
 
 def draw_study(out, scene, task, fields, rows, sampled):
@@ -89,11 +107,21 @@ def _lines(out, scene, task, rows, plotted, field):
     label, scale = field_axis(scene, field)
     x = np.array([r[field] for r in rows], float) * scale
     order = np.argsort(x)
+    failed = _failed(rows)
     n = len(plotted)
     fig, axes = _figure(math.ceil(n / 2), min(n, 2))
     for ax, column in zip(axes, plotted):
         y = _values(rows, column)
         ax.plot(x[order], y[order], "o-", color="C0")
+        # points without a value sit on the lower edge: x failed, o no value (e.g. no lock-up in t_end)
+        missing = ~np.isfinite(y)
+        for mask, marker, text in ((failed, "x", "failed point"), (missing & ~failed, "o", "no value")):
+            if mask.any():
+                ax.plot(x[mask], np.zeros(mask.sum()), marker, color="C3", mfc="none", ms=8, clip_on=False,
+                        transform=ax.get_xaxis_transform(), label=text)
+        if missing.any():
+            ax.legend(fontsize=7)
+        ticks_at(ax.xaxis, x[np.isfinite(x)])
         ax.set_xlabel(label)
         ax.set_ylabel(result_label(column))
         ax.grid(True, alpha=0.3)
@@ -107,6 +135,7 @@ def _maps(out, scene, task, rows, plotted, fields):
     xs = np.unique([r[fields[1]] for r in rows])
     ys = np.unique([r[fields[0]] for r in rows])
     (x_label, x_scale), (y_label, y_scale) = field_axis(scene, fields[1]), field_axis(scene, fields[0])
+    failed = _failed(rows)
     n = len(plotted)
     cols = min(n, 2)
     # Fixed margins, not the constrained layout: it measured every tick label twice and took 60 % of
@@ -115,16 +144,30 @@ def _maps(out, scene, task, rows, plotted, fields):
     # outer edges only (less to read, and a fifth less to draw).
     fig, axes = _figure(math.ceil(n / 2), cols, width=4.8, height=3.6, layout=None, share=True)
     rows_of_axes = math.ceil(n / 2)
-    fig.subplots_adjust(left=0.12, right=0.94, bottom=0.16 / rows_of_axes, top=1 - 0.28 / rows_of_axes,
+    fig.subplots_adjust(left=0.12, right=0.94, bottom=0.16 / rows_of_axes, top=1 - 0.3 / rows_of_axes,
                         wspace=0.35, hspace=0.3)
+    cell = [(np.searchsorted(ys, r[fields[0]]), np.searchsorted(xs, r[fields[1]])) for r in rows]
     for k, (ax, column) in enumerate(zip(axes, plotted)):
+        values = _values(rows, column)
         grid = np.full((ys.size, xs.size), np.nan)
-        for r, v in zip(rows, _values(rows, column)):
-            grid[np.searchsorted(ys, r[fields[0]]), np.searchsorted(xs, r[fields[1]])] = v
-        mesh = ax.pcolormesh(_edges(xs) * x_scale, _edges(ys) * y_scale, np.ma.masked_invalid(grid),
+        for (i, j), v in zip(cell, values):
+            grid[i, j] = v
+        constant = flat_value(values) is not None
+        # a result constant to round-off is one colour with its value stated, not a map of noise
+        shown = np.where(np.isfinite(grid), np.nanmean(values), np.nan) if constant else grid
+        mesh = ax.pcolormesh(_edges(xs) * x_scale, _edges(ys) * y_scale, np.ma.masked_invalid(shown),
                              shading="flat", cmap="viridis")
-        fig.colorbar(mesh, ax=ax)                 # the panel's title names the result and its unit
+        if constant:
+            _constant_note(ax, values, column)
+        else:
+            fig.colorbar(mesh, ax=ax)             # the panel's title names the result and its unit
+        for (i, j), v, bad in zip(cell, values, failed):
+            if bad or not np.isfinite(v):
+                ax.text(xs[j] * x_scale, ys[i] * y_scale, "x" if bad else "-", ha="center", va="center",
+                        color="C3", fontsize=11, fontweight="bold")
         ax.set_title(result_label(column), fontsize=10)
+        ticks_at(ax.xaxis, xs, x_scale)
+        ticks_at(ax.yaxis, ys, y_scale)
         bottom, left = k + cols >= n, k % cols == 0     # no panel drawn below it / first column
         ax.tick_params(labelbottom=bottom, labelleft=left)
         if bottom:
@@ -133,8 +176,8 @@ def _maps(out, scene, task, rows, plotted, fields):
             ax.set_ylabel(y_label)
     for ax in axes[n:]:
         ax.set_visible(False)
-    fig.suptitle(_title(scene, task, rows) + "\nblank cell: no value (a failed point, or no lock-up within t_end)",
-                 fontsize=11)
+    fig.suptitle(_title(scene, task, rows) + "\nticks at the sampled values; x: failed point, "
+                 "-: no value (e.g. no lock-up within t_end)", fontsize=11)
     return save_figure(fig, out / "sweep_maps.png")
 
 
@@ -153,10 +196,13 @@ def _histograms(out, scene, task, rows, plotted):
     for ax, column in zip(axes, plotted):
         y = _values(rows, column)
         y = y[np.isfinite(y)]
+        ax.set_ylabel("points")
+        if _constant_note(ax, y, column):
+            ax.set_xticks([])
+            continue
         ax.hist(y, bins=max(5, min(30, int(np.sqrt(y.size)) + 1)), color="C0", alpha=0.8)
         ax.axvline(np.mean(y), color="k", ls="--", lw=1, label=f"mean {np.mean(y):.4g}")
         ax.set_xlabel(result_label(column))
-        ax.set_ylabel("points")
         ax.legend(fontsize=8)
     for ax in axes[n:]:
         ax.set_visible(False)
@@ -172,13 +218,19 @@ def _scatter(out, scene, task, rows, plotted, fields):
         for j, field in enumerate(fields):
             ax = axes[i, j]
             label, scale = field_axis(scene, field)
-            ax.plot([r[field] * scale for r in rows], y, ".", color="C0", ms=4)
+            x = np.array([r[field] for r in rows], float) * scale
+            ax.plot(x, y, ".", color="C0", ms=4)
+            missing = ~np.isfinite(y)
+            if missing.any():        # failed points and points without a value, on the lower edge
+                ax.plot(x[missing], np.zeros(missing.sum()), "x", color="C3", ms=5, clip_on=False,
+                        transform=ax.get_xaxis_transform())
             if i == len(plotted) - 1:
                 ax.set_xlabel(label)
             if j == 0:
                 ax.set_ylabel(result_label(column), fontsize=8)
             ax.grid(True, alpha=0.3)
-    fig.suptitle(_title(scene, task, rows).replace("sweep", "Monte Carlo") + ": each result against each sampled field")
+    fig.suptitle(_title(scene, task, rows).replace("sweep", "Monte Carlo") + ": each result against each sampled "
+                 "field (x on the lower edge: no value)")
     return save_figure(fig, out / "sample_scatter.png")
 
 
@@ -216,6 +268,7 @@ def _curves(out, scene, task, rows, fields):
     ax.grid(True, alpha=0.3)
     t_max = task.options.get("t_max")
     limit = f"t_max = {t_max:g} s" if t_max else "t_max = each point's own baseline lock-up time"
-    fig.suptitle(f"{scene.name}: optimal engagement pressure, {len(by_point)} operating points\n"
+    fig.suptitle(scene_title(scene.name, f"optimal engagement pressure, {len(by_point)} operating points",
+                             task.base_overrides) + "\n"
                  f"each curve ends at its lock-up; {limit}", fontsize=10)
     return save_figure(fig, out / "optimal_curves.png")

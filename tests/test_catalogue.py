@@ -9,6 +9,7 @@ one of those limits.
 
 import math
 import re
+import warnings
 from pathlib import Path
 
 import casadi as ca
@@ -16,6 +17,7 @@ import numpy as np
 import pytest
 
 from clutchocp.engagement.model import EngagementModel
+from clutchocp.errors import PlausibilityWarning
 from clutchocp.physics.contact import greenwood_tripp_pressure
 from clutchocp.scene import list_scenes, load_scene
 
@@ -121,8 +123,17 @@ def test_contact_capacity_closed_form_matches_the_library_quadrature():
 
 @pytest.mark.parametrize("path", FILES, ids=[p.stem for p in FILES])
 def test_catalogue_clutch_loads_matches_readme_and_is_consistent(path):
-    scene = load_scene(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PlausibilityWarning)      # a catalogue clutch is a plausible clutch
+        scene = load_scene(path)
+    assert scene.warnings == ()
     row = ROWS[path.stem]
+    if scene.has("thermal"):       # the lining's conduction nodes: the README names material, thickness, cells
+        described = (f"thermal: {scene.value('thermal.lining_material')} lining, "
+                     f"{scene.value('plates.lining_thickness') * 1e3:g} mm, {scene.value('thermal.lining_cells')} cells")
+        assert described in row["lining"], (described, row["lining"])
+    else:
+        assert "thermal" not in row["lining"]
     assert scene.name == path.stem and scene.kind == "engagement"
     assert scene.source.strip() and len(scene.value("scene.assumptions")) >= 5
     assert scene.get("actuation.max_pressure") is not None          # clutchocp optimize needs it

@@ -27,10 +27,13 @@ field that moves it (:class:`~clutchocp.errors.ModelError`; the command line exi
   their least work over t_max is added): no command dissipates less;
 * **the temperature limit** (:func:`temperature_bound`): the plate temperatures are linear in the
   heat released, so the interface temperature at lock-up is its free response plus the convolution of
-  the heat power with the impulse response g(t) of the thermal part, which falls with time (heat
-  spreads and convects away). The least it can be, for any heat history of total E at t_f, is
-  T_free(t_f) + E g(t_f) (all the heat at t = 0); the peak temperature is at least its smallest value
-  over the lock-up times the problem allows;
+  the heat power with the impulse response g(t) of the thermal part. For the lining's conduction
+  nodes (:class:`~clutchocp.engagement.thermal.LiningConduction`: C dT/dt = -K (T - T_oil) + Q e_0 with
+  C diagonal, K symmetric positive definite) g(t) = e_0' C^-1/2 exp(-C^-1/2 K C^-1/2 t) C^-1/2 e_0 is
+  a sum of decaying exponentials with weights >= 0, so it falls with time (heat spreads into the
+  lining and core and convects away). The least the interface temperature can be, for any heat
+  history of total E at t_f, is T_free(t_f) + E g(t_f) (all the heat at t = 0); the peak temperature
+  is at least its smallest value over the lock-up times the problem allows;
 * **the specific-power limit**: E <= q_max A t_f, so no lock-up under q_max is faster than
   E_min / (q_max A) (A the friction area of all interfaces); and the drag of the open pack at t = 0
   (its heat power at the initial state) must already be within the limit.

@@ -136,7 +136,13 @@ def QOpt(dim, default, check="nonnegative", doc="", span=None):
 RADIUS = Span((0.01, 1.5), (1e-3, 5.0), "a clutch radius")
 PRESSURE = Span((1e3, MAX_PRESSURE), (0.0, MAX_PRESSURE), "a clutch oil pressure", zero=True)
 SPEED = Span((1.0, 2000.0), (0.0, 3e4), "a clutch shaft speed", zero=True)
-INERTIA = Span((1e-4, 100.0), (1e-7, 1e5), "a driveline inertia")
+# Inertias reflected to the clutch or brake shaft: 1e-4 kg m^2 (a small actuator's clutch) to 1e5 kg m^2.
+# A car's mass at its gearbox output is 5-15 kg m^2; a 40 t truck's at its propshaft (r 0.5 m, axle 4:1)
+# about 600 kg m^2; a haul truck's wheel-end brake behind a hub reduction 1e3-1e4 kg m^2 (25 t at 1.3 m
+# through 6:1: 1174 kg m^2; 150 t of an ultra-class truck at 1.9 m through 6:1: 1.5e4 kg m^2); a rail
+# axle's share (20 t at 0.5 m through 4:1) about 300 kg m^2. A brake at wheel speed with no reduction
+# (ultra-class front wheels: about 4e5 kg m^2) is unusual but runs; 1e7 kg m^2 is no clutch's.
+INERTIA = Span((1e-4, 1e5), (1e-7, 1e7), "a driveline inertia")
 TORQUE = Span((0.0, 2e4), (0.0, 1e6), "a clutch or load torque", zero=True)
 ROUGHNESS = Span((1e-8, 3e-5), (1e-10, 1e-3), "an RMS surface roughness", zero=True)
 MODULUS = Span((1e6, 3e11), (1e4, 1e12), "an elastic modulus")

@@ -7,6 +7,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 import pytest
+from scipy.integrate import quad
 
 from clutchocp.engagement.model import EngagementModel
 from clutchocp.engagement.run import simulate_engagement
@@ -91,19 +92,73 @@ def test_energy_bound_is_approached_by_a_hard_constant_torque_lock():
     assert energy == pytest.approx(0.5 * I_eq * w0**2, rel=2e-3)
 
 
-def test_thermal_responses_are_the_lumped_closed_forms():
-    """Impulse response a^2/C_s e^(-G t/C_s) + (1 - a)^2/C_f e^(-G t/C_f) and the free cooling of the
-    lumped plates (clutchocp.physics.thermal), from their equations by the matrix exponential."""
-    scene = load_scene("default_driveline_thermal").with_overrides({"thermal.initial_temperature_C": 70.0})
+def _thermal_numbers(scene):
+    """(C_sep, C_f, C_lining, g_lining, G): the default thermal scene's capacities [J/K] and conductances
+    [W/K] from its keys: n A d rho c of the paper lining, n A k / d across it, h n A to the oil per side."""
+    n, d = scene.value("plates.n_interfaces"), scene.value("plates.lining_thickness")
+    A = math.pi * (scene.value("plates.r_outer") ** 2 - scene.value("plates.r_inner") ** 2)
+    k, rho, c = 0.2, 1000.0, 1500.0                              # thermal.lining_material = "paper"
+    return 142.0, 144.0, n * A * d * rho * c, n * A * k / d, 1000.0 * n * A
+
+
+def test_thermal_responses_are_the_two_node_closed_forms():
+    """One conduction cell: the surface node (separator and half the lining, C_0 = C_sep + C_l/2) and the
+    back node (the other half and the core, C_1 = C_f - C_l/2), joined by g = n A k / d, each convecting
+    G = h n A. The 2 x 2 system's exponential in closed form, e^(At) = e^(st) [cosh(dt) I + sinh(dt)/d (A - sI)]
+    (s = tr A / 2, d = sqrt(s^2 - det A)), gives the impulse response of the interface temperature and its
+    free cooling from 70 degC to the 40 degC oil; the linearised model (thermal_response) must equal them."""
+    scene = load_scene("default_driveline_thermal").with_overrides(
+        {"thermal.initial_temperature_C": 70.0, "thermal.lining_cells": 1})
     model = EngagementModel(scene, pressure_command=ca.SX.sym("u"))
     free, impulse = thermal_response(model)
-    a, C_f, C_s = 0.961, 144.0, 142.0
-    G = 1000.0 * model.film.area * 4
-    for t in (0.0, 0.3, 5.0):
-        g = a**2 / C_s * math.exp(-G * t / C_s) + (1 - a) ** 2 / C_f * math.exp(-G * t / C_f)
-        assert impulse(t) == pytest.approx(g, rel=1e-9)
-        cool = a * (40 + 30 * math.exp(-G * t / C_s)) + (1 - a) * (40 + 30 * math.exp(-G * t / C_f))
-        assert free(t) == pytest.approx(cool, rel=1e-9)
+    C_sep, C_f, C_l, g, G = _thermal_numbers(scene)
+    C0, C1 = C_sep + C_l / 2, C_f - C_l / 2
+    A = np.array([[-(g + G) / C0, g / C0], [g / C1, -(g + G) / C1]])
+    s = np.trace(A) / 2
+    d = math.sqrt(s**2 - np.linalg.det(A))
+
+    def row0(t):                   # the first row of e^(At)
+        ch, sh = math.cosh(d * t), math.sinh(d * t) / d
+        return math.exp(s * t) * np.array([ch + sh * (A[0, 0] - s), sh * A[0, 1]])
+
+    for t in (0.0, 0.05, 0.3, 5.0):
+        e = row0(t)
+        assert impulse(t) == pytest.approx(e[0] / C0, rel=1e-9)
+        assert free(t) == pytest.approx(40.0 + 30.0 * (e[0] + e[1]), rel=1e-9)
+
+
+def test_thermal_impulse_response_of_the_lining_nodes():
+    """The default 6 cells: at t = 0 the heat is in the surface node alone, g(0) = 1 / (C_sep + half the first
+    cell); over all time the heat of an impulse leaves through both convections, so int_0^inf g dt is the
+    steady rise per watt, 1 / (G + 1 / (d / (n A k) + 1 / G)) (the lining's series resistance is d / (n A k)
+    whatever the cells); and g falls all the time (the premise of the temperature bound)."""
+    scene = load_scene("default_driveline_thermal")
+    model = EngagementModel(scene, pressure_command=ca.SX.sym("u"))
+    _, impulse = thermal_response(model)
+    C_sep, _, C_l, g, G = _thermal_numbers(scene)
+    first_cell = 1.0 / sum(1.5**j for j in range(6))             # the cells grow 1.5 x from the surface
+    assert impulse(0.0) == pytest.approx(1.0 / (C_sep + C_l * first_cell / 2), rel=1e-9)
+    total = sum(quad(impulse, a, b, limit=200)[0] for a, b in ((0.0, 0.1), (0.1, 10.0), (10.0, 400.0)))
+    assert total == pytest.approx(1.0 / (G + 1.0 / (1.0 / g + 1.0 / G)), rel=1e-6)
+    samples = [impulse(t) for t in np.geomspace(1e-5, 60.0, 60)]
+    assert all(b < a for a, b in zip(samples, samples[1:]))
+
+
+def test_temperature_bound_holds_for_any_heat_history():
+    """The bound T_free(t_f) + E g(t_f) against the chain's own temperatures (ConductionChain.relax, the
+    matrix exponential of the conduction nodes, not the model's linearisation): E released at a constant
+    power over [0, t_f], or all in the last tenth, heats the interface more; all at t = 0 gives the bound."""
+    scene = load_scene("default_driveline_thermal").with_overrides({"thermal.initial_temperature_C": 55.0})
+    model = EngagementModel(scene, pressure_command=ca.SX.sym("u"))
+    chain, T_oil = model.thermal.chain, 40.0
+    energy, t_f = 2500.0, 0.2
+    bound = temperature_bound(model, energy, t_f, t_f)
+    start = np.full(chain.size, 55.0)
+    at_once = chain.relax(start + energy * chain.matrix()[1], t_f, T_oil)[0]
+    assert bound == pytest.approx(at_once, rel=1e-9)
+    steady = chain.relax(start, t_f, T_oil, heat=energy / t_f)[0]
+    late = chain.relax(chain.relax(start, 0.9 * t_f, T_oil), 0.1 * t_f, T_oil, heat=energy / (0.1 * t_f))[0]
+    assert bound < steady < late
 
 
 def test_temperature_bound_is_below_the_idas_peak():

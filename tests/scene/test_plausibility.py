@@ -36,9 +36,9 @@ EXAMPLES = [
     ({"actuation.pressure": 8}, False,
      "actuation.pressure = 8 Pa is unusual for a clutch oil pressure (typical 1000 to 1e+08 Pa); "
      "did you mean 8 bar or 8 MPa?"),
-    ({"driveline.output_inertia": 1e4}, False,
-     "driveline.output_inertia = 10000 kg m^2 is unusual for a driveline inertia (typical 0.0001 to 100 kg m^2); "
-     "did you mean 10000 kg cm^2?"),
+    ({"driveline.output_inertia": 1e6}, False,
+     "driveline.output_inertia = 1e+06 kg m^2 is unusual for a driveline inertia (typical 0.0001 to 100000 kg m^2); "
+     "did you mean 1e+06 kg cm^2?"),
     ({"driveline.input_speed": 3000}, False, "did you mean 3000 rpm?"),
     ({"thermal.oil_temperature_C": 313}, False, "did you mean 313 K"),
     ({"plates.r_outer": "85 m"}, True, "plates.r_outer = 85 m is not a clutch radius"),

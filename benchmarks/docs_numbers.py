@@ -620,15 +620,22 @@ def _default(field):
     return f"{field.default:g}{unit}"
 
 
+def _plausible(field):
+    """The key's plausibility spans (:class:`clutchocp.scene.schema.Span`), or "" for a key without."""
+    if field.span is None:
+        return ""
+    return field.span.describe(field.dim)
+
+
 def _field_rows(fields):
-    return [(f"`{key}`", _unit(f), _allowed(f), _default(f), f.doc) for key, f in fields.items()]
+    return [(f"`{key}`", _unit(f), _allowed(f), _plausible(f), _default(f), f.doc) for key, f in fields.items()]
 
 
 def scene_keys_page():
     """docs/scene-keys.md: every part and key of a scene file, from :mod:`clutchocp.scene.schema`."""
     sys.path.insert(0, str(ROOT))
     from clutchocp.scene import list_scenes
-    from clutchocp.scene.schema import PARTS, REQUIRED_PARTS
+    from clutchocp.scene.schema import PARTS, REQUIRED_PARTS, RETIRED
 
     scenes = list_scenes()
     lines = ["# Scene keys", "",
@@ -642,12 +649,18 @@ def scene_keys_page():
              "- *absent*: the key may be left out and then has no value (the model does without it or says what "
              "it needs); **required**: the scene must give it.",
              "- A part with variants chooses one with `model = \"...\"`; the keys of the other variants are not "
-             "allowed then. A part a scene does not declare adds no states and no equations.", "",
+             "allowed then. A part a scene does not declare adds no states and no equations.",
+             "- *allowed*: a value outside is refused in one line naming the key. *plausible*: the values a wet "
+             "clutch has (*typical*) and those any wet clutch stays within; a value outside the typical span is "
+             "a warning on stderr and in `summary.json` (`warnings`) and the run goes on, one outside the limits "
+             "is refused with the unit it was probably written in (e.g. `plates.r_outer = 85` read as 85 m: "
+             "\"did you mean 85 mm\"). A key whose 0 means none (*0 = none*) accepts 0 whatever its spans.", "",
              "Parts each kind of scene must declare:", ""]
     lines += [f"- `{kind}`: " + ", ".join(f"`[{p}]`" for p in parts) for kind, parts in REQUIRED_PARTS.items()]
-    lines += ["", "Contents: " + ", ".join(f"[`[{p}]`](#{p})" for p in PARTS) + ", [`[uncertainty]`](#uncertainty)",
+    lines += ["", "Contents: " + ", ".join(f"[`[{p}]`](#{p})" for p in PARTS) + ", [`[uncertainty]`](#uncertainty)"
+              + (", [keys that no longer exist](#keys-that-no-longer-exist)" if RETIRED else ""),
               ""]
-    header = ("key", "unit", "allowed", "default", "meaning")
+    header = ("key", "unit", "allowed", "plausible", "default", "meaning")
     for name, part in PARTS.items():
         used = [s.name for s in scenes if name in s.raw]
         lines += [f"## {name}", "", f"`[{name}]`: {part.doc}.", ""]
@@ -675,6 +688,10 @@ def scene_keys_page():
                                                  "field), drawn with equal weight")]),
               "The nominal is the scene's own value. On the command line: `--uncertain \"friction.mu=uniform 10 %\"` "
               "(repeatable). A spread that leaves a field's allowed range is refused with the field named.", ""]
+    if RETIRED:
+        lines += ["## Keys that no longer exist", "",
+                  "A scene that still has one is refused in one line saying what took its place:", "",
+                  table(("key", "what to do"), [(f"`{key}`", why) for key, why in RETIRED.items()])]
     return "\n".join(lines).rstrip() + "\n"
 
 

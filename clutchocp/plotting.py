@@ -3,7 +3,8 @@
 :func:`finish` is applied to every figure when it is saved (:func:`clutchocp.output.save_figure`) or
 handed to the user (``result.plot()``):
 
-- tick labels are plain numbers, never an offset ("1e-8 - 5.3077484e1" above the axis);
+- tick labels are plain numbers, never an offset ("1e-8 - 5.3077484e1" above the axis), and on log
+  axes "0.5", "20" rather than "5 x 10^-1", "2 x 10^1";
 - a series constant to round-off is drawn as a flat line with its value stated, not as a signal
   (:data:`FLAT_REL`);
 - a legend inside the axes is moved to their right, outside the data, and the figure is widened by
@@ -31,14 +32,31 @@ FLAT_REL = 1e-7
 LEGEND_WRAP = 34          # characters per legend line
 
 
+def _plain_log_formatter(**kw):
+    """A log-axis tick formatter that writes plain numbers ("0.5", "20", "1e-05"), not "5 x 10^-1"."""
+    from matplotlib.ticker import LogFormatter
+
+    class PlainLogFormatter(LogFormatter):
+        def _num_to_string(self, x, vmin, vmax):
+            return f"{x:.4g}"
+
+    return PlainLogFormatter(**kw)
+
+
 def plain_numbers(ax):
-    """Plain tick labels on both axes of ``ax`` (no offset, no "x 1e5" multiplier on linear axes)."""
-    from matplotlib.ticker import ScalarFormatter
+    """Plain tick labels on both axes of ``ax``: no offset and no "x 1e5" multiplier on linear axes;
+    on log axes numbers instead of powers of ten, with the 2, 3, 4, 6 ticks labelled when the axis
+    spans less than two decades (matplotlib's default formatters only; a formatter set by hand stays)."""
+    from matplotlib.ticker import LogFormatterMathtext, LogFormatterSciNotation, ScalarFormatter
 
     for axis in (ax.xaxis, ax.yaxis):
         formatter = axis.get_major_formatter()
         if isinstance(formatter, ScalarFormatter):
             formatter.set_useOffset(False)
+        elif type(formatter) in (LogFormatterSciNotation, LogFormatterMathtext):
+            axis.set_major_formatter(_plain_log_formatter(labelOnlyBase=False))
+            if type(axis.get_minor_formatter()) in (LogFormatterSciNotation, LogFormatterMathtext):
+                axis.set_minor_formatter(_plain_log_formatter(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
 
 
 def flat_value(values, rel=FLAT_REL):

@@ -38,6 +38,18 @@ def test_round_off_is_drawn_flat_with_its_value_and_no_offset():
     assert ax.yaxis.get_major_formatter().get_offset() == ""
 
 
+def test_log_ticks_are_plain_numbers_with_the_in_between_ticks_on_a_short_axis():
+    fig, ax = figure()
+    ax.plot([0.0, 1.0], [7.3, 85.0])
+    ax.set_yscale("log")
+    finish(fig)
+    fig.canvas.draw()
+    major = [t.get_text() for t in ax.get_yticklabels() if t.get_text()]
+    minor = [t.get_text() for t in ax.get_yticklabels(minor=True) if t.get_text()]
+    assert "10" in major and {"20", "40", "60"} <= set(minor)
+    assert not any("times" in t or "^" in t or "$" in t for t in major + minor)
+
+
 def test_a_legend_moves_outside_the_data_and_the_figure_widens():
     fig, ax = figure()
     ax.plot([0, 1], [0, 1], label="a curve with a long label that would cover the data")
@@ -130,3 +142,22 @@ def test_the_kiss_spike_does_not_set_the_jerk_scale():
     assert spike > 3 * rest                                   # the scene's own step kisses hard
     assert ax.get_ylim()[1] < 0.5 * spike                     # the scale is the slip phase's
     assert any("kiss" in a.get_text() and "off scale" in a.get_text() for a in ax.texts)
+
+
+def test_film_pressures_are_drawn_against_the_cavitation_limit(monkeypatch, tmp_path):
+    from clutchocp.engagement import figures as engagement_figures
+
+    figures = {}
+    monkeypatch.setattr(engagement_figures, "save_figure", lambda fig, path: figures.setdefault(path.name, fig))
+    run = clutchocp.simulate("bao2020")
+    engagement_figures.plot_engagement(run, tmp_path)
+    left, right = figures["film_pressure.png"].axes[:2]
+    p_cav = run.summary["film_cavitation_pressure_Pa"] / 1e6
+    lowest = run.summary["min_film_pressure_Pa"] / 1e6
+    for ax in (left, right):
+        low, high = ax.get_ylim()
+        assert low < p_cav < high and any(list(line.get_ydata()[:1]) == [p_cav] for line in ax.get_lines())
+    low, high = right.get_ylim()
+    # the suction after lock-up (bao2020's centrifugal film) is readable: not scaled to the impact's ~20 MPa
+    assert low < lowest < 0.0 < high < 2.0
+    assert any("cavitation pressure" in t.get_text() for t in right.get_legend().get_texts())

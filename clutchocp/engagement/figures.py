@@ -57,6 +57,7 @@ def plot_engagement(run, out):
     fig.suptitle(scene_title(model.scene, "oil films"))
     _mark_lockup(ax0, run)
     files.append(_finish(fig, ax, run, out / "gaps.png"))
+    files.append(plot_film_pressure(run, out / "film_pressure.png", t_early))
 
     fig, (ax,) = new_figure()
     ax.plot(t, res["w_in_rad_s"], label="input")
@@ -93,6 +94,56 @@ def plot_engagement(run, out):
         files.append(plot_torque_response(run, out / "torque_response.png"))
     files.append(plot_heat(run, out / "heat.png"))
     return files
+
+
+MAX_FILMS_LABELLED = 8
+
+
+def plot_film_pressure(run, path, t_early):
+    """The mean gauge pressure of each film against the cavitation pressure, the lowest a film holds
+    (``film.cavitation_pressure``, drawn as a line); dashed, the averaged Reynolds film at the same closing
+    speed without that limit (below the line the film has cavitated). Left panel the first ``t_early``
+    seconds (the squeeze, to scale), right panel the rest of the run scaled to its own values and the
+    limit (where suction after the squeeze shows); returns the PNG path."""
+    from matplotlib.lines import Line2D
+
+    res, model, summary = run.result, run.model, run.summary
+    t = res.t
+    p_cav = summary["film_cavitation_pressure_Pa"] / 1e6
+    later = t >= t_early
+    rest = later.sum() > 1 and t_early < t[-1]
+    fig, (ax0, ax) = new_figure(2, width=5.0)
+    shown = []
+    for k in range(1, model.n + 1):
+        color = f"C{(k - 1) % 10}"
+        mean = res[f"film_{k}_mean_pressure_Pa"] / 1e6
+        reynolds = res[f"film_{k}_reynolds_pressure_Pa"] / 1e6
+        for panel in (ax0, ax):
+            panel.plot(t, mean, color=color, lw=1.2)
+            panel.plot(t, reynolds, color=color, lw=0.8, ls="--")
+        shown += [mean[later], reynolds[later]] if rest else []
+        if model.n <= MAX_FILMS_LABELLED or k in (1, model.n):
+            ax.plot([], [], color=color, lw=1.2, label=f"film {k}")
+    ax.add_line(Line2D([], [], color="0.3", lw=0.8, ls="--", label="dashed: the Reynolds film without the limit"))
+    for panel in (ax0, ax):
+        panel.axhline(p_cav, color="k", lw=1.0, ls=":",
+                      label=f"cavitation pressure {p_cav:.3g} MPa" if panel is ax else None)
+        panel.axhline(0.0, color="0.6", lw=0.5)
+        panel.grid(alpha=0.3)
+        panel.set(xlabel="time [s]", ylabel="mean film pressure, gauge [MPa]")
+    ax0.set(xlim=(t[0], t_early), title=f"the first {t_early:.3g} s")
+    lowest = (f"lowest {summary['min_film_pressure_Pa']:.3g} Pa, film {summary['min_film_pressure_film']} "
+              f"at {summary['min_film_pressure_time_s']:.3g} s")
+    if rest:
+        values = np.concatenate([v[np.isfinite(v)] for v in shown] + [[p_cav, 0.0]])
+        low, high = values.min(), values.max()
+        pad = 0.08 * (high - low)
+        ax.set(xlim=(t_early, t[-1]), ylim=(low - pad, high + pad), title=f"after {t_early:.3g} s; {lowest}")
+    else:
+        ax.set_title(f"whole run; {lowest}")
+    fig.suptitle(scene_title(model.scene, "film pressures and the cavitation limit"))
+    _mark_lockup(ax0, run)
+    return _finish(fig, ax, run, path)
 
 
 def plot_torque_response(run, path):

@@ -1,7 +1,8 @@
 """Run time of one engagement against the number of plate pairs, with the fitted growth exponent.
 
 The scene is rebuilt with ``plates.n_interfaces = n`` (and, for a pack of masses, n copies of
-the first plate mass); everything else stays. More pairs carry more torque, so the engagement
+the first plate mass; with a [thermal] part, the pack's plate heat capacities, which are totals
+over the interfaces, in proportion to n); everything else stays. More pairs carry more torque, so the engagement
 itself changes (it locks sooner); the report gives the IDAS steps beside the time, so the
 cost per step can be told apart from the physics. The exponent p of ``time ~ n^p`` is the slope
 of a least-squares line through (log n, log time).
@@ -19,11 +20,19 @@ from ..output import new_figure, save_figure
 PAIRS = (1, 2, 4, 8, 16)
 
 
+THERMAL_TOTALS = ("thermal.separator_heat_capacity", "thermal.friction_plate_heat_capacity")   # [J/K], whole pack
+
+
 def with_pairs(scene, n):
-    """``scene`` with ``n`` friction interfaces (plate masses repeated for a pack of masses)."""
+    """``scene`` with ``n`` friction interfaces (plate masses repeated for a pack of masses; the
+    pack's heat capacities, totals over the interfaces, scaled by ``n`` over the scene's count, so
+    each interface keeps its plates)."""
     overrides = {"plates.n_interfaces": int(n)}
     if scene.variant("pack") == "masses":
         overrides["pack.plate_masses"] = [float(scene.value("pack.plate_masses")[0])] * int(n)
+    if scene.has("thermal"):
+        ratio = int(n) / scene.value("plates.n_interfaces")
+        overrides.update({key: scene.value(key) * ratio for key in THERMAL_TOTALS})
     return scene.with_overrides(overrides)
 
 

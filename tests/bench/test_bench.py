@@ -74,6 +74,15 @@ def test_with_pairs_repeats_the_plate_mass():
     assert scaling.with_pairs(load_scene("zhang2021"), 3).value("plates.n_interfaces") == 3
 
 
+def test_with_pairs_keeps_the_heat_capacity_of_each_interface():
+    scene = load_scene("default_driveline")                          # [thermal], 4 interfaces
+    for n in (1, 16):                                                # 16: more than the linings of 4 pairs hold
+        variant = scaling.with_pairs(scene, n)
+        for key in scaling.THERMAL_TOTALS:
+            per_interface = scene.value(key) / scene.value("plates.n_interfaces")
+            assert variant.value(key) / variant.value("plates.n_interfaces") == pytest.approx(per_interface, rel=1e-15)
+
+
 @pytest.fixture(scope="module")
 def zhang():
     scene = load_scene("zhang2021")

@@ -36,14 +36,17 @@ import argparse
 import csv
 import datetime
 import hashlib
+import heapq
+import itertools
 import json
 import os
 import re
 import subprocess
 import sys
 import tempfile
+import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -55,14 +58,118 @@ COMMAND_PAGES = ROOT / "docs" / "commands"
 
 
 # -- running the tool -----------------------------------------------------------------------------
-def clutchocp(*args, cwd=None, timeout=3600):
-    """Run ``clutchocp ARGS`` in a fresh interpreter; returns its stdout (raises with stderr on failure)."""
-    env = {**os.environ, "MPLBACKEND": "Agg"}
-    proc = subprocess.run([sys.executable, "-m", "clutchocp.cli", *args], capture_output=True, text=True,
-                          cwd=cwd, env=env, timeout=timeout)
-    if proc.returncode != 0:
-        raise RuntimeError(f"clutchocp {' '.join(args)} exited {proc.returncode}: {proc.stderr.strip()[-2000:]}")
-    return proc.stdout
+COMMAND_TIMEOUT_S = 3 * 3600          # one command; the slowest (robust, 200 samples) takes ~10-35 min
+
+
+class Slots:
+    """At most ``n`` commands at once; a free slot goes to the waiting request of the highest priority
+    (lowest number), then the earliest. An item waits for a slot per command, never while holding one."""
+
+    def __init__(self, n):
+        self.free = n
+        self.waiting = []
+        self.tickets = itertools.count()
+        self.cond = threading.Condition()
+
+    def acquire(self, priority):
+        with self.cond:
+            ticket = (priority, next(self.tickets))
+            heapq.heappush(self.waiting, ticket)
+            while not (self.free and self.waiting[0] == ticket):
+                self.cond.wait()
+            heapq.heappop(self.waiting)
+            self.free -= 1
+            self.cond.notify_all()
+
+    def release(self):
+        with self.cond:
+            self.free += 1
+            self.cond.notify_all()
+
+
+@dataclass
+class Run:
+    """One finished command: its folder (``--out``), what it printed and how long it took [s]."""
+
+    folder: Path
+    stdout: str
+    stderr: str
+    returncode: int
+    seconds: float
+
+
+class Runner:
+    """One measuring session: a scratch folder, the command slots, and every command run so far.
+
+    Each command runs once per session in a fresh interpreter on the checkout's own package, into a
+    folder of its own (``NNN_<label>`` under the scratch folder); an item asking for a command another
+    item has run (or is running) gets that run (e.g. ``clutchocp simulate zhang2021`` serves the scene
+    table and the physics page, ``clutchocp optimize`` the README and the scene table).
+    """
+
+    def __init__(self, root, jobs):
+        self.root = Path(root)
+        self.slots = Slots(jobs)
+        self.lock = threading.Lock()
+        self.count = itertools.count(1)
+        self.runs = {}                   # command -> (threading.Event, [Run or exception])
+        self.env = {**os.environ, "MPLBACKEND": "Agg",
+                    "PYTHONPATH": os.pathsep.join([str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])}
+
+    def folder(self, label):
+        """A new folder name under the scratch folder, unique in the session (not created)."""
+        with self.lock:
+            number = next(self.count)
+        return self.root / f"{number:03d}_{re.sub(r'[^A-Za-z0-9_.=-]+', '_', label)[:80]}"
+
+    def _execute(self, argv, folder, cwd, timeout, priority):
+        self.slots.acquire(priority)
+        try:
+            start = time.perf_counter()
+            proc = subprocess.run(argv, capture_output=True, text=True, cwd=cwd, env=self.env, timeout=timeout)
+            seconds = time.perf_counter() - start
+        finally:
+            self.slots.release()
+        return Run(folder, proc.stdout, proc.stderr, proc.returncode, seconds)
+
+    def clutchocp(self, *args, priority=0, check=True, timeout=COMMAND_TIMEOUT_S):
+        """``clutchocp ARGS --out FOLDER``, run once per session; returns its :class:`Run`.
+
+        With ``check`` a non-zero exit raises (with the end of stderr); without, the failed run is returned."""
+        with self.lock:
+            entry = self.runs.get(args)
+            owner = entry is None
+            if owner:
+                entry = self.runs[args] = (threading.Event(), [])
+        done, box = entry
+        if owner:
+            try:
+                folder = self.folder("_".join(args))
+                folder.parent.mkdir(parents=True, exist_ok=True)
+                box.append(self._execute([sys.executable, "-m", "clutchocp.cli", *args, "--out", str(folder)],
+                                         folder, self.root, timeout, priority))
+            except BaseException as exc:      # noqa: BLE001 - handed to every item that waits for this run
+                box.append(exc)
+                raise
+            finally:
+                done.set()
+        done.wait()
+        result = box[0]
+        if isinstance(result, BaseException):
+            raise RuntimeError(f"clutchocp {' '.join(args)} failed: {result}")
+        if check and result.returncode != 0:
+            raise RuntimeError(f"clutchocp {' '.join(args)} exited {result.returncode}: "
+                               f"{result.stderr.strip()[-2000:]}")
+        return result
+
+    def python(self, code, label, priority=0, timeout=COMMAND_TIMEOUT_S):
+        """``python -c CODE`` in a folder of its own (its working directory); returns its :class:`Run`."""
+        folder = self.folder(label)
+        folder.mkdir(parents=True)
+        run = self._execute([sys.executable, "-c", code], folder, folder, timeout, priority)
+        if run.returncode != 0:
+            raise RuntimeError(f"{label} exited {run.returncode}: {run.stderr.strip()[-2000:]}")
+        return run
 
 
 def flat_keys(value, path=()):
@@ -125,16 +232,78 @@ def pick(mapping, *names):
 
 
 # -- the items: each measures what some docs quote -------------------------------------------------
+class Item:
+    """What one item measures with: the session's :class:`Runner` at the item's priority, and the
+    commands it used (their seconds, a run shared with another item counted for both)."""
+
+    def __init__(self, runner, name, priority):
+        self.runner, self.name, self.priority = runner, name, priority
+        self.seconds = []
+        self.lock = threading.Lock()
+
+    def _count(self, run):
+        with self.lock:
+            self.seconds.append(run.seconds)
+        return run
+
+    def clutchocp(self, *args, check=True):
+        """``clutchocp ARGS --out FOLDER`` (once per session, see :meth:`Runner.clutchocp`)."""
+        return self._count(self.runner.clutchocp(*args, priority=self.priority, check=check))
+
+    def many(self, commands, check=True):
+        """Several ``clutchocp`` commands at once (as slots free up); their runs in the order given."""
+        box = [None] * len(commands)
+
+        def one(k):
+            try:
+                box[k] = self.clutchocp(*commands[k], check=check)
+            except Exception as exc:      # noqa: BLE001 - raised below, in the item's thread
+                box[k] = exc
+        threads = [threading.Thread(target=one, args=(k,), daemon=True) for k in range(len(commands))]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        for result in box:
+            if isinstance(result, Exception):
+                raise result
+        return box
+
+    def python(self, code, label):
+        """``python -c CODE`` in a folder of its own; returns its :class:`Run`."""
+        return self._count(self.runner.python(code, label, priority=self.priority))
+
+
 MEASURES = ("engagement_time_s", "lockup_torque_jump_Nm", "jerk_integral", "peak_jerk_rad_s3", "peak_torque_Nm",
             "dissipated_energy_J")
 
 
-def optimize_default(work):
+def default_scene():
+    """The name of the default engagement scene (``clutchocp optimize`` without a scene)."""
+    sys.path.insert(0, str(ROOT))
+    from clutchocp.scene import list_scenes
+
+    return next(s.name for s in list_scenes() if s.value("scene.default"))
+
+
+def engagement_scenes():
+    sys.path.insert(0, str(ROOT))
+    from clutchocp.scene import list_scenes
+
+    return [s.name for s in list_scenes() if s.kind == "engagement"]
+
+
+def optimize_command(name):
+    """The command that optimises scene ``name``: plain ``optimize`` for the default scene, so that the
+    README's command and the scene table share one run."""
+    return ("optimize",) if name == default_scene() else ("optimize", name)
+
+
+def optimize_default(item):
     """``clutchocp optimize --out DIR``: the first command of the README, on the default scene."""
-    out = work / "optimize"
-    stdout = clutchocp("optimize", "--out", str(out))
-    s = summary_of(out)
-    table = stdout[stdout.index("scene default_driveline: optimal"):].rstrip() if "optimal engagement" in stdout \
+    run = item.clutchocp("optimize")
+    stdout, s = run.stdout, summary_of(run.folder)
+    table = stdout[stdout.index(f"scene {s['scene']}: optimal"):].rstrip() if "optimal engagement" in stdout \
         else stdout.rstrip()
     return {
         "command": "clutchocp optimize --out out/optimize",
@@ -150,29 +319,21 @@ def optimize_default(work):
         "peak_interface_temperature_C": (s.get("heat") or {}).get("idas", {}).get("peak_interface_temperature_C"),
         "t_max_s": s["limits"]["t_max_s"],
         "printed": table,
-        "keys": folder_keys(out),
+        "keys": folder_keys(run.folder),
     }
 
 
 WEIGHT_VARIANTS = ("jerk=1,energy=10", "jerk=0,time=1", "jerk=1,energy=0.1")
 
 
-def optimize_weights(work):
+def optimize_weights(item):
     """``clutchocp optimize --weights ...`` on the default scene: what each objective weight trades."""
+    runs = item.many([("optimize", "--weights", weights) for weights in WEIGHT_VARIANTS])
     rows = {}
-    for weights in WEIGHT_VARIANTS:
-        out = work / f"weights_{len(rows)}"
-        clutchocp("optimize", "--weights", weights, "--out", str(out))
-        s = summary_of(out)
+    for weights, run in zip(WEIGHT_VARIANTS, runs):
+        s = summary_of(run.folder)
         rows[weights] = {**pick(s["optimal"], *MEASURES), "passed": s["verification"]["passed"]}
     return {"command": "clutchocp optimize --weights W --out DIR", "rows": rows}
-
-
-def engagement_scenes():
-    sys.path.insert(0, str(ROOT))
-    from clutchocp.scene import list_scenes
-
-    return [s.name for s in list_scenes() if s.kind == "engagement"]
 
 
 SIMULATE_NUMBERS = ("engagement_time_s", "lockup_torque_jump_Nm", "peak_torque_Nm", "peak_jerk_rad_s3",
@@ -181,59 +342,54 @@ SIMULATE_NUMBERS = ("engagement_time_s", "lockup_torque_jump_Nm", "peak_torque_N
                     "peak_specific_power_W_mm2", "peak_interface_temperature_C", "wall_time_s")
 
 
-def simulate_scenes(work):
+def simulate_scenes(item):
     """``clutchocp simulate SCENE`` for every built-in engagement scene."""
-    rows, keys = {}, []
-    for name in engagement_scenes():
-        out = work / f"simulate_{name}"
-        clutchocp("simulate", name, "--out", str(out))
-        rows[name] = pick(summary_of(out), *SIMULATE_NUMBERS)
-        keys.append(folder_keys(out))
-    return {"command": "clutchocp simulate SCENE --out DIR", "rows": rows, "keys": merge_keys(*keys)}
+    names = engagement_scenes()
+    runs = item.many([("simulate", name) for name in names])
+    rows = {name: pick(summary_of(run.folder), *SIMULATE_NUMBERS) for name, run in zip(names, runs)}
+    return {"command": "clutchocp simulate SCENE --out DIR", "rows": rows,
+            "keys": merge_keys(*(folder_keys(run.folder) for run in runs))}
 
 
 CYCLE_RUNS = (("default_driveline_thermal", 0.5), ("default_driveline_thermal", 5.0), ("default_driveline", 0.5))
 
 
-def cycles(work):
+def cycles(item):
     """``clutchocp cycles SCENE --cycles 10 --cooling-time S --max-temperature 110``."""
-    runs, keys = [], []
-    for name, cooling in CYCLE_RUNS:
-        out = work / f"cycles_{name}_{cooling:g}"
-        clutchocp("cycles", name, "--cycles", "10", "--cooling-time", f"{cooling:g}", "--max-temperature", "110",
-                  "--out", str(out))
-        s = summary_of(out)
-        runs.append({"scene": name, "cooling_time_s": cooling, "stop_reason": s["stop_reason"],
-                     "drift_s": s["engagement_time_drift_s"],
-                     "cycles": [pick(c, "cycle", "start_interface_temperature_C", "peak_interface_temperature_C",
-                                     "engagement_time_s") for c in s["cycles"]]})
-        keys.append(folder_keys(out))
+    runs = item.many([("cycles", name, "--cycles", "10", "--cooling-time", f"{cooling:g}", "--max-temperature", "110")
+                      for name, cooling in CYCLE_RUNS])
+    out = []
+    for (name, cooling), run in zip(CYCLE_RUNS, runs):
+        s = summary_of(run.folder)
+        out.append({"scene": name, "cooling_time_s": cooling, "stop_reason": s["stop_reason"],
+                    "drift_s": s["engagement_time_drift_s"],
+                    "cycles": [pick(c, "cycle", "start_interface_temperature_C", "peak_interface_temperature_C",
+                                    "engagement_time_s") for c in s["cycles"]]})
     return {"command": "clutchocp cycles SCENE --cycles 10 --cooling-time S --max-temperature 110 --out DIR",
-            "runs": runs, "keys": merge_keys(*keys)}
+            "runs": out, "keys": merge_keys(*(folder_keys(run.folder) for run in runs))}
 
 
-def validate(work):
+def validate(item):
     """``clutchocp validate``: the static analyses against the seed papers."""
-    out = work / "validate"
-    clutchocp("validate", "--out", str(out))
-    return {"command": "clutchocp validate --out DIR", "summary": summary_of(out), "keys": folder_keys(out)}
+    run = item.clutchocp("validate")
+    return {"command": "clutchocp validate --out DIR", "summary": summary_of(run.folder),
+            "keys": folder_keys(run.folder)}
 
 
 CONTROL_RUNS = (("liao2021_hvd", "lqi"), ("cui2019_hvd", "pi"))
 
 
-def control(work):
+def control(item):
     """``clutchocp control SCENE --controller SPEC`` on both hydro-viscous drive scenes."""
-    rows, keys = {}, []
-    for name, spec in CONTROL_RUNS:
-        out = work / f"control_{name}"
-        clutchocp("control", name, "--controller", spec, "--out", str(out))
-        s = summary_of(out)
+    runs = item.many([("control", name, "--controller", spec) for name, spec in CONTROL_RUNS])
+    rows = {}
+    for (name, spec), run in zip(CONTROL_RUNS, runs):
+        s = summary_of(run.folder)
         rows[f"{name} {spec}"] = {**pick(s["margins"], "gain_margin_dB", "phase_margin_deg", "all_points_stable"),
                                   **pick(s["closed_loop"], "overshoot_pct", "settling_time_s", "steady_state_error_rel",
                                          "time_in_saturation_s")}
-        keys.append(folder_keys(out))
-    return {"command": "clutchocp control SCENE --controller SPEC --out DIR", "rows": rows, "keys": merge_keys(*keys)}
+    return {"command": "clutchocp control SCENE --controller SPEC --out DIR", "rows": rows,
+            "keys": merge_keys(*(folder_keys(run.folder) for run in runs))}
 
 
 SWEEPS = (
@@ -245,28 +401,24 @@ SWEEPS = (
 )
 
 
-def sweep(work):
-    """``clutchocp sweep``: a simulate grid, Monte Carlo samples and an optimize grid (what they write)."""
-    rows, keys = {}, []
-    for label, args in SWEEPS:
-        out = work / f"sweep_{len(rows)}"
-        clutchocp("sweep", *args, "--workers", "1", "--out", str(out))
-        s = summary_of(out)
+def sweep(item):
+    """``clutchocp sweep``: a simulate grid, Monte Carlo samples and an optimize grid (what they write);
+    one worker each, as the slots run the commands side by side."""
+    runs = item.many([("sweep", *args, "--workers", "1") for _, args in SWEEPS])
+    rows = {}
+    for (label, args), run in zip(SWEEPS, runs):
         rows[label] = {"command": "clutchocp sweep " + " ".join(f"'{a}'" if " " in a else a for a in args),
-                       **pick(s, "points", "points_ok", "points_failed")}
-        keys.append(folder_keys(out))
-    return {"rows": rows, "keys": merge_keys(*keys)}
+                       **pick(summary_of(run.folder), "points", "points_ok", "points_failed")}
+    return {"rows": rows, "keys": merge_keys(*(folder_keys(run.folder) for run in runs))}
 
 
-def optimize_scenes(work):
+def optimize_scenes(item):
     """``clutchocp optimize SCENE`` for every engagement scene: solve, IDAS check, time."""
-    rows, keys = {}, []
-    for name in engagement_scenes():
-        out = work / f"optimize_{name}"
-        start = time.perf_counter()
-        clutchocp("optimize", name, "--out", str(out))
-        wall = time.perf_counter() - start
-        s = summary_of(out)
+    names = engagement_scenes()
+    runs = item.many([optimize_command(name) for name in names])
+    rows = {}
+    for name, run in zip(names, runs):
+        s = summary_of(run.folder)
         solves = s.get("mesh", {}).get("solves", [])
         rows[name] = {
             "phases": " + ".join(p["name"] for p in s["phases"]),
@@ -274,50 +426,109 @@ def optimize_scenes(work):
             "stages": ", ".join(x["stage"] for x in solves),
             "iterations": sum(x["iterations"] or 0 for x in solves) or s["solver"]["iterations"],
             "ipopt_s": sum(x["wall_time_s"] or 0.0 for x in solves) or s["solver"]["wall_time_s"],
-            "command_s": wall,
+            "command_s": run.seconds,
             "t_f_s": s["optimal"]["engagement_time_s"],
             "lock_time_rel_diff": s["verification"]["lock_time_rel_diff"],
             "torque_jump_rel": s["verification"]["torque_jump_rel"],
             "passed": s["verification"]["passed"],
+            "min_film_pressure_Pa": (s["verification"].get("idas") or {}).get("min_film_pressure_Pa"),
             "fill_comparison": {k: pick(v, "engagement_time_s", "peak_jerk_rad_s3", "lockup_torque_jump_Nm",
                                         "kiss_speed_m_s", "dissipated_energy_J")
                                 for k, v in s["fill_comparison"].items() if k in ("optimal", "baseline")}
             if "fill_comparison" in s else None,
         }
-        keys.append(folder_keys(out))
-    return {"command": "clutchocp optimize SCENE --out DIR", "rows": rows, "keys": merge_keys(*keys)}
+    return {"command": "clutchocp optimize SCENE --out DIR", "rows": rows,
+            "keys": merge_keys(*(folder_keys(run.folder) for run in runs))}
 
 
-def robust(work):
+def robust(item):
     """``clutchocp robust --samples 200 --seed 0``: the four shift-control strategies over the default box."""
-    out = work / "robust"
-    clutchocp("robust", "--samples", "200", "--seed", "0", "--workers", "1", "--out", str(out))
-    s = summary_of(out)
+    run = item.clutchocp("robust", "--samples", "200", "--seed", "0", "--workers", "1")
+    s = summary_of(run.folder)
     stats = {name: {**pick(v, "lock_share", "lock_within_t_max_share"),
                     "jump_pct": v.get("jump_pct"), "jerk_integral_median": (v.get("jerk_integral") or {}).get("median")}
              for name, v in s["statistics"].items()}
     return {"command": "clutchocp robust --samples 200 --seed 0 --out DIR", "t_max_s": s["t_max_s"],
             "strategies": s["strategies"], "statistics": stats,
             "acceptance": {k: v.get("passed") for k, v in s["acceptance"].items()},
-            "samples_per_s": s["timing"]["samples_per_s"], "keys": folder_keys(out)}
+            "samples_per_s": s["timing"]["samples_per_s"], "keys": folder_keys(run.folder)}
 
 
-def bench(work):
+def bench(item):
     """``clutchocp bench --quick``: IDAS against scipy's integrators at matched error."""
-    out = work / "bench"
-    clutchocp("bench", "--quick", "--out", str(out))
-    s = summary_of(out)
-    return {"command": "clutchocp bench --quick --out DIR", "summary": s, "keys": folder_keys(out)}
+    run = item.clutchocp("bench", "--quick")
+    return {"command": "clutchocp bench --quick --out DIR", "summary": summary_of(run.folder),
+            "keys": folder_keys(run.folder)}
 
 
-def readme_example(work):
+def readme_example(item):
     """The Python example of the README, run as a user would, and what it prints."""
     code = examples()["readme"]
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=work, timeout=1800,
-                          env={**os.environ, "MPLBACKEND": "Agg"})
-    if proc.returncode != 0:
-        raise RuntimeError(f"the README example failed: {proc.stderr.strip()[-2000:]}")
-    return {"code_sha256": code_hash(code), "stdout": proc.stdout}
+    run = item.python(code, "readme_example")
+    return {"code_sha256": code_hash(code), "stdout": run.stdout}
+
+
+# The physics page: its closed forms (docs/scripts/physics_numbers.py) and the runs it quotes.
+PHYSICS_SCRIPT = ROOT / "docs" / "scripts" / "physics_numbers.py"
+THERMAL_CELLS = (1, 2, 3, 4, 6, 20)
+PHYSICS_NUMBERS = ("engagement_time_s", "peak_torque_Nm", "specific_energy_J_mm2", "peak_specific_power_W_mm2",
+                   "energy_balance_rel_error", "min_film_pressure_Pa", "peak_interface_temperature_C",
+                   "peak_friction_plate_temperature_C", "peak_core_temperature_C")
+# `clutchocp simulate default_driveline --set ...`: what the plausibility and capacity checks answer
+EDGE_EXAMPLES = ("plates.r_outer=85", "oil.viscosity=40", "roughness.sigma_1=8", "driveline.input_speed=1e6",
+                 "actuation.pressure=8", "driveline.output_inertia=1e6")
+CAPACITY_EXAMPLE = "roughness.sigma_1=6 um"
+
+
+def physics_runs():
+    """{label: clutchocp arguments} of the simulations docs/physics.md quotes."""
+    sys.path.insert(0, str(ROOT))
+    from clutchocp.scene import load_scene
+
+    zhang = load_scene("zhang2021")
+    half = (zhang.value("roughness.sigma_1") ** 2 + zhang.value("roughness.sigma_2") ** 2) ** 0.5 / 2 ** 0.5
+    runs = {"zhang2021": ("simulate", "zhang2021"),
+            "zhang2021_equal_split": ("simulate", "zhang2021", "--set", f"roughness.sigma_1={half!r}",
+                                      "--set", f"roughness.sigma_2={half!r}"),
+            "zhang2021_1000rpm": ("simulate", "zhang2021", "--set", "driveline.input_speed=1000 rpm"),
+            "default_driveline": ("simulate", "default_driveline"),
+            "bao2020": ("simulate", "bao2020")}
+    for cells in THERMAL_CELLS:        # the scene's own cell count is the plain run (shared with the scene table)
+        own = load_scene("default_driveline_thermal").value("thermal.lining_cells") == cells
+        runs[f"thermal_cells_{cells}"] = ("simulate", "default_driveline_thermal") if own else \
+            ("simulate", "default_driveline_thermal", "--set", f"thermal.lining_cells={cells}")
+    return runs
+
+
+def last_row(folder, column):
+    """The last value of ``column`` in a run's timeseries.csv."""
+    with (Path(folder) / "timeseries.csv").open(newline="", encoding="utf-8") as handle:
+        rows = list(csv.DictReader(handle))
+    return float(rows[-1][column])
+
+
+def physics(item):
+    """docs/physics.md: the closed forms of ``docs/scripts/physics_numbers.py``, the simulations it quotes
+    and what the plausibility and contact-capacity checks print."""
+    labels, commands = zip(*physics_runs().items())
+    checks = (*EDGE_EXAMPLES, CAPACITY_EXAMPLE)
+    runs = item.many([*commands, *(("simulate", "default_driveline", "--set", s) for s in checks)], check=False)
+    sims, answers = dict(zip(labels, runs[:len(labels)])), dict(zip(checks, runs[len(labels):]))
+    for label, run in sims.items():
+        if run.returncode != 0:
+            raise RuntimeError(f"physics: {label} exited {run.returncode}: {run.stderr.strip()[-2000:]}")
+    gaps = {name: last_row(sims[name].folder, "h_1_m") for name in ("zhang2021", "default_driveline")}
+    code = (f"import json, runpy; m = runpy.run_path({str(PHYSICS_SCRIPT)!r}); "
+            f"print(json.dumps({{'formulas': m['formulas'](), 'settled_contact': "
+            f"{{n: m['contact_data'](n, g) for n, g in {gaps!r}.items()}}}}))")
+    closed = json.loads(item.python(code, "physics_formulas").stdout)
+    message = {s: next((line.split(": ", 1)[1] for line in run.stderr.splitlines()
+                        if line.startswith("clutchocp simulate: ")), run.stderr.strip()[-300:])
+               for s, run in answers.items()}
+    return {"command": "clutchocp simulate SCENE [--set ...] --out DIR; docs/scripts/physics_numbers.py",
+            **closed, "runs": {label: pick(summary_of(run.folder), *PHYSICS_NUMBERS) for label, run in sims.items()},
+            "settled_gap_m": gaps,
+            "checks": {s: {"exit": answers[s].returncode, "message": message[s]} for s in checks}}
 
 
 ITEMS = {
@@ -325,6 +536,7 @@ ITEMS = {
     "readme_example": readme_example,
     "optimize_weights": optimize_weights,
     "simulate_scenes": simulate_scenes,
+    "physics": physics,
     "cycles": cycles,
     "validate": validate,
     "control": control,
@@ -333,9 +545,10 @@ ITEMS = {
     "robust": robust,
     "bench": bench,
 }
-# The longest first, so that two at a time finish together.
-ORDER = ("robust", "bench", "optimize_scenes", "sweep", "optimize_weights", "cycles", "control", "simulate_scenes",
-         "optimize_default", "readme_example", "validate")
+# Priority of an item's commands when two wait for a slot: the longest first, so that the two slots
+# finish together (robust ~35 %, bench and optimize_scenes ~25 % each of the commands' time).
+ORDER = ("robust", "optimize_scenes", "bench", "optimize_weights", "sweep", "control", "optimize_default",
+         "simulate_scenes", "physics", "cycles", "readme_example", "validate")
 KEYS_OF = {"optimize": ("optimize_default", "optimize_scenes"), "simulate": ("simulate_scenes",),
            "cycles": ("cycles",), "validate": ("validate",), "control": ("control",), "sweep": ("sweep",),
            "robust": ("robust",), "bench": ("bench",)}
@@ -782,29 +995,46 @@ def render_all(numbers, write=True):
 
 
 def measure(names, jobs):
-    """Run the items ``names`` (two at a time by default); returns {name: values} of those that worked."""
+    """Run the items ``names``, their commands ``jobs`` at a time; returns ({name: values} of those that
+    worked, {name: error} of those that failed, the wall time [s])."""
     today = datetime.date.today().isoformat()
     results, failures = {}, {}
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="docs_numbers_") as scratch:
+        runner = Runner(scratch, jobs)
 
-    def run(name):
-        start = time.perf_counter()
-        with tempfile.TemporaryDirectory(prefix=f"docs_{name}_") as work:
-            values = ITEMS[name](Path(work))
-        values["measured"] = today
-        values["item_wall_time_s"] = round(time.perf_counter() - start, 1)
-        print(f"  {name}: {values['item_wall_time_s']:.0f} s", flush=True)
-        return values
-
-    order = [n for n in ORDER if n in names]
-    with ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {name: pool.submit(run, name) for name in order}
-        for name, future in futures.items():
+        def run(name):
+            item = Item(runner, name, ORDER.index(name))
+            begin = time.perf_counter()
             try:
-                results[name] = future.result()
+                values = ITEMS[name](item)
             except Exception as exc:     # noqa: BLE001 - one failed item keeps the others' numbers
                 failures[name] = str(exc)
                 print(f"  {name}: FAILED: {exc}", file=sys.stderr, flush=True)
-    return results, failures
+                return
+            values["measured"] = today
+            values["item_wall_time_s"] = round(time.perf_counter() - begin, 1)
+            values["item_command_s"] = round(sum(item.seconds), 1)
+            results[name] = values
+            print(f"  {name}: done after {values['item_wall_time_s']:.0f} s "
+                  f"({len(item.seconds)} commands, {values['item_command_s']:.0f} s of command time)", flush=True)
+
+        threads = [threading.Thread(target=run, args=(name,), daemon=True) for name in ORDER if name in names]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        commands = sorted(((run[1][0].seconds, " ".join(args)) for args, run in runner.runs.items()
+                           if run[1] and isinstance(run[1][0], Run)), reverse=True)
+    for seconds, command in commands:
+        print(f"    {seconds:7.1f} s  clutchocp {command}")
+    return results, failures, time.perf_counter() - start
+
+
+def positive_int(text):
+    if not text.isdigit() or int(text) < 1:
+        raise argparse.ArgumentTypeError(f"--jobs must be a whole number >= 1, got {text!r}")
+    return int(text)
 
 
 def main(argv=None):
@@ -813,7 +1043,8 @@ def main(argv=None):
     parser.add_argument("--skip", default="", help="comma-separated items not to measure")
     parser.add_argument("--render", action="store_true", help="no measuring: rewrite the docs from the JSON")
     parser.add_argument("--check", action="store_true", help="exit 1 if a doc differs from what --render writes")
-    parser.add_argument("--jobs", type=int, default=2, help="items measured at once (default: 2)")
+    parser.add_argument("--jobs", type=positive_int, default=2,
+                        help="commands run at once (default: 2; 1 on a machine others use)")
     args = parser.parse_args(argv)
     numbers = load_numbers()
     if args.check:
@@ -828,13 +1059,12 @@ def main(argv=None):
         if unknown:
             parser.error(f"unknown items {unknown}; the items are {', '.join(ITEMS)}")
         names = [n for n in names if n not in args.skip.split(",")]
-        start = time.perf_counter()
-        print(f"measuring {', '.join(names)} ({args.jobs} at a time)", flush=True)
-        results, failures = measure(names, args.jobs)
+        print(f"measuring {', '.join(names)} ({args.jobs} commands at a time)", flush=True)
+        results, failures, wall = measure(names, args.jobs)
         numbers.update(results)
         JSON_PATH.write_text(json.dumps(numbers, indent=1, sort_keys=True) + "\n")
         numbers = load_numbers()          # render what is stored (sorted keys), as the tests do
-        print(f"measured in {time.perf_counter() - start:.0f} s; wrote {JSON_PATH.relative_to(ROOT)}")
+        print(f"measured in {wall:.0f} s; wrote {JSON_PATH.relative_to(ROOT)}")
     for path in render_all(numbers):
         print(f"rewrote {path.relative_to(ROOT)}")
     for command, missing in undocumented_all(numbers).items():

@@ -928,10 +928,21 @@ def _segment_regex(segment):
     return re.compile("".join(".+" if p.startswith("<") and p.endswith(">") else re.escape(p) for p in parts))
 
 
+PLACEHOLDER = re.compile(r"<[^<>]+>")
+SCENE_FIELD = re.compile(r"[A-Za-z_]\w*\.[A-Za-z_]\w*")
+
+
+def key_spans(page):
+    """The code spans of a page with a literal name in them; a span that is a placeholder alone (`<i>`,
+    `<field>`) names no summary key, and only a scene field (``part.key``) as a column (see :func:`undocumented`)."""
+    return {span for span in SPAN.findall(Path(page).read_text(encoding="utf-8"))
+            if re.search(r"\w", PLACEHOLDER.sub("", span))}
+
+
 def documented_patterns(page):
-    """The key patterns a page documents: every code span, braces expanded, split into segments."""
+    """The key patterns a page documents: every key span, braces expanded, split into segments."""
     patterns = []
-    for span in SPAN.findall(Path(page).read_text(encoding="utf-8")):
+    for span in key_spans(page):
         for text in _expand(span.strip()):
             patterns.append([_segment_regex(s) for s in text.split(".")])
     return patterns
@@ -949,12 +960,15 @@ def undocumented(keys, page):
     """What of ``keys`` (a :func:`folder_keys` result) the page does not document:
     summary key paths (dotted) and ``file.csv: column`` entries."""
     patterns = documented_patterns(page)
-    spans = set(SPAN.findall(Path(page).read_text(encoding="utf-8")))
+    spans = key_spans(page)
     columns = [re.compile("".join(".+" if p.startswith("<") else re.escape(p)
                                   for p in re.split(r"(<[^<>]+>)", s))) for span in spans for s in _expand(span)]
+    # `<field>` alone: a column per swept or drawn scene field (part.key)
+    fields = any(PLACEHOLDER.fullmatch(span) for span in SPAN.findall(Path(page).read_text(encoding="utf-8")))
     missing = [".".join(k) for k in keys["summary"] if not any(_matches(k, p) for p in patterns)]
     for name, header in keys["csv"].items():
-        missing += [f"{name}: {c}" for c in header if not any(r.fullmatch(c) for r in columns)]
+        missing += [f"{name}: {c}" for c in header
+                    if not (any(r.fullmatch(c) for r in columns) or (fields and SCENE_FIELD.fullmatch(c)))]
     missing += [f"file {f}" for f in keys["files"] if not any(r.fullmatch(f) for r in columns)]
     return missing
 

@@ -102,6 +102,14 @@ def test_docs_the_key_check_reports_what_a_page_lacks(tmp_path):
     assert dn.undocumented(keys, page) == ["a.e.d", "empty[].*", "t.csv: y_3_m", "file other.png"]
 
 
+def test_docs_a_placeholder_alone_documents_only_scene_field_columns(tmp_path):
+    page = tmp_path / "page.md"
+    page.write_text("film number `<i>`; one column per swept field: `<field>`\n")
+    keys = {"summary": [["lockup_s"], ["runs[]", "x"]], "csv": {"r.csv": ["oil.viscosity", "T_core"]},
+            "files": ["a.png"]}
+    assert dn.undocumented(keys, page) == ["lockup_s", "runs[].x", "r.csv: T_core", "file a.png"]
+
+
 @pytest.fixture(scope="module")
 def written(tmp_path_factory):
     """The folders of the quick commands, run now: {command: folder_keys}."""

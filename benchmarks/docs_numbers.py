@@ -765,6 +765,142 @@ def r_bench(n):
             + f"\n(speed-ups at matched error; `{n['bench']['command']}`; {measured(n, 'bench')}.)\n")
 
 
+# -- docs/physics.md ---------------------------------------------------------------------------------
+def _phys(n):
+    return n["physics"]
+
+
+def _run(n, label):
+    return _phys(n)["runs"][label]
+
+
+def r_physics_wall(n):
+    rows = [(f"{w['eps']:g}", f"{w['smooth_drag']:.3f}", f"{w['rough_viscous']:.3f}", f"{w['form_drag']:.3f}")
+            for w in _phys(n)["formulas"]["one_dimensional_wall"]]
+    return table(("eps", "smooth-wall drag", "rough-wall viscous shear", "form drag"), rows) + \
+        f"\n(`python docs/scripts/physics_numbers.py`; {measured(n, 'physics')}.)\n"
+
+
+def r_physics_shear_factors(n):
+    rows = [(f"{r['H']:g}", f"{r['phi_f']:.3f}", f"{r['Phi_fs']:.3f}", f"{r['rough_viscous']:.3f}",
+             f"{r['patir_cheng']:.3f}", f"{r['table']:.3f}", f"{r['h_T_over_h']:.3f}")
+            for r in _phys(n)["formulas"]["shear_factors"]]
+    return table(("H", "phi_f", "Phi_fs", "rough wall's viscous phi_f - Phi_fs", "transmitted phi_f + Phi_fs",
+                  "transmitted, deterministic flow (`\"table\"`)", "h_T / h"), rows) + \
+        f"\n(`clutchocp.physics.shear`, one rough wall over the nominal film h; {measured(n, 'physics')}.)\n"
+
+
+def r_physics_shear_effect(n):
+    z, e, d = _run(n, "zhang2021"), _run(n, "zhang2021_equal_split"), _run(n, "default_driveline")
+    return (f"Effect on the built-in scenes (`clutchocp simulate SCENE`): zhang2021 (lining rough, separator "
+            f"smooth) locks at {fmt(z['engagement_time_s'])} s with a {fmt(z['peak_torque_Nm'])} N m peak (the "
+            f"roughness split equally: {fmt(e['engagement_time_s'])} s and {fmt(e['peak_torque_Nm'])} N m); "
+            f"default_driveline locks at {fmt(d['engagement_time_s'])} s. ({measured(n, 'physics')}; CHANGELOG.md "
+            "has the values before the correction.)\n")
+
+
+def r_physics_zhang_printed(n):
+    z, low = _phys(n)["formulas"]["zhang_as_printed"], _run(n, "zhang2021_1000rpm")
+    return (f"Table 1's {fmt(z['speed_rad_s'])} rad/s is {z['speed_rpm']:.0f} rpm, {z['rim_speed_m_s']:.0f} m/s at "
+            f"the outer radius (high for a vehicle clutch). One stop puts {z['energy_J'] / 1e3:.0f} kJ on one "
+            f"{z['area_mm2']:.0f} mm^2 friction face, {fmt(z['specific_energy_J_mm2'], 3)} J/mm^2: some twenty times "
+            f"what a paper lining survives in one engagement (about 1-2 J/mm^2); kept in a 2 mm steel separator and "
+            f"a plate of like heat capacity ({z['steel_plate_J_K']:.0f} J/K each) it would heat them by "
+            f"{z['two_steel_plates_rise_K']:.0f} K. At {z['low_speed']} "
+            f"(`--set \"driveline.input_speed='{z['low_speed']}'\"`, the plausible alternative) it is "
+            f"{fmt(low['specific_energy_J_mm2'], 3)} J/mm^2 and the lock-up comes at "
+            f"{fmt(low['engagement_time_s'], 3)} s. ({measured(n, 'physics')}.)\n")
+
+
+def r_physics_contact_data(n):
+    c = _phys(n)["settled_contact"]
+    z, d = c["zhang2021"], c["default_driveline"]
+    return (f"Zhang's asperity data give n beta sigma = {fmt(z['n_beta_sigma'], 3)}, about ten times "
+            f"Greenwood-Williamson's usual 0.03-0.05: his real-area ratio pi n beta sigma F_1(H) is "
+            f"{fmt(z['area_ratio'], 3)} at zhang2021's settled film (H = {fmt(z['settled_H'], 3)}); the "
+            f"Greenwood-Tripp ratio of default_driveline with the same data is {fmt(d['area_ratio'], 3)} at its "
+            f"settled film (H = {fmt(d['settled_H'], 3)}) and reaches the cap of {pct(d['cap'])} at "
+            f"H = {fmt(d['cap_H'], 2)}. ({measured(n, 'physics')}.)\n")
+
+
+def r_physics_cavitation_offset(n):
+    c = _phys(n)["formulas"]["cavitation"]
+    return (f"With the corner width w = {c['width']:g} |L| the squeeze load is off by at most "
+            f"{fmt(c['offset'], 2)} |L| ({fmt(c['offset_Pa_at_1_bar'] / 1e3, 2)} kPa of mean pressure at -1 bar); "
+            f"the residual slope is eps = {c['residual_slope']:g}.\n")
+
+
+def r_physics_film_pressures(n):
+    d, b = _run(n, "default_driveline"), _run(n, "bao2020")
+    return (f"The shipped scenes' own runs never pull their films: the lowest mean film pressure is "
+            f"{fmt(d['min_film_pressure_Pa'], 2)} Pa on default_driveline and {fmt(b['min_film_pressure_Pa'], 2)} Pa "
+            f"on bao2020 (the centrifugal suction after lock-up); their energy balances close to "
+            f"{fmt(d['energy_balance_rel_error'], 2)} and {fmt(b['energy_balance_rel_error'], 2)}. "
+            f"({measured(n, 'physics')}.)\n")
+
+
+def r_physics_optimum_film_pressure(n):
+    rows = n["optimize_scenes"]["rows"]
+    z, b = (rows[name]["min_film_pressure_Pa"] for name in ("zhang2021", "bao2020"))
+    return (f"Lowest mean film pressure of the IDAS replay (`verification.idas.min_film_pressure_Pa`): "
+            f"{fmt(z / 1e5, 3)} bar for zhang2021's optimum, {fmt(b / 1e5, 3)} bar for bao2020's "
+            f"(`clutchocp optimize SCENE`; {measured(n, 'optimize_scenes')}).\n")
+
+
+def r_physics_capacity(n):
+    c = _phys(n)["formulas"]["capacity_examples"]
+    return (f"which scales as sigma^2.5 E': {fmt(c['greenwood_tripp'] / 1e6, 3)} MPa for Zhang 2021's asperities at "
+            f"sigma = 8.41 um (default_driveline), {fmt(c['greenwood_tripp_6um'] / 1e6, 3)} MPa at 6 um. Zhang's "
+            f"variant (`contact.model = \"zhang_gw\"`, load E delta^2 with delta = pi n_a beta sigma F_1(H)) carries "
+            f"E (pi n_a beta sigma phi(0))^2 ({fmt(c['zhang_gw'] / 1e6, 3)} MPa for zhang2021). "
+            f"({measured(n, 'physics')}.)\n")
+
+
+def _answer(n, setting):
+    a = _phys(n)["checks"][setting]
+    return f"$ clutchocp simulate default_driveline --set \"{setting}\"\n{a['message']}"
+
+
+def r_physics_plausible(n):
+    return "```text\n" + "\n".join(_answer(n, s) for s in EDGE_EXAMPLES) + \
+        f"\n```\n({measured(n, 'physics')}; exit code 2 for an error, 0 with a warning.)\n"
+
+
+def r_physics_capacity_example(n):
+    return f"```text\n{_answer(n, CAPACITY_EXAMPLE)}\n```\n"
+
+
+def r_physics_capacity_ratios(n):
+    rows = [(f"`{name}`", r["law"], fmt(r["capacity_Pa"] / 1e6, 3), fmt(r["run_ratio"], 2),
+             fmt(r["max_pressure_ratio"], 2))
+            for name, r in _phys(n)["formulas"]["contact_capacity"].items()]
+    return table(("scene", "contact law", "capacity at zero gap [MPa]", "largest pack pressure / capacity, its run",
+                  "up to `actuation.max_pressure`"), rows) + f"\n({measured(n, 'physics')}.)\n"
+
+
+def r_physics_conduction(n):
+    c = _phys(n)["formulas"]["conduction"]
+    rows = [(cells, *(pct(e, 2) for e in errors)) for cells, errors in c["errors"].items()]
+    return table(("cells", *(f"{t:g} s" for t in c["times_s"])), rows) + f"\n({measured(n, 'physics')}.)\n"
+
+
+def r_physics_thermal(n):
+    t = _run(n, "thermal_cells_6")
+    q = t["peak_specific_power_W_mm2"] * 1e6          # W/m^2
+    steel_k, half = 50.0, 1e-3                         # W/(m K), m: the separator's steel, half-thickness
+    cells = ", ".join(f"{c} cell{'s' if c > 1 else ''} {fmt(_run(n, f'thermal_cells_{c}')['peak_interface_temperature_C'], 3)}"
+                      for c in THERMAL_CELLS)
+    return (f"On default_driveline_thermal (`clutchocp simulate default_driveline_thermal`) the interface (the "
+            f"lining's surface) peaks at {fmt(t['peak_interface_temperature_C'], 3)} degC, the friction plates' bulk "
+            f"at {fmt(t['peak_friction_plate_temperature_C'], 3)} degC, their core at "
+            f"{fmt(t['peak_core_temperature_C'], 3)} degC; the energy balance, counting the heat stored in every "
+            f"node, closes to {fmt(t['energy_balance_rel_error'], 2)}. Left out is the gradient across the "
+            f"separator's steel itself, about q L / (3 k) under a flux q on a half-thickness L: "
+            f"{fmt(q * half / (3 * steel_k), 2)} K at this engagement's peak {fmt(t['peak_specific_power_W_mm2'], 3)} "
+            f"W/mm^2 (L = 1 mm, k = 50 W/(m K)). Peak interface temperature against the cell count "
+            f"(`--set thermal.lining_cells=N`): {cells} degC. ({measured(n, 'physics')}.)\n")
+
+
 RENDERERS = {
     "optimize-default-table": r_optimize_default_table,
     "optimize-default-printed": r_optimize_default_printed,
@@ -779,6 +915,20 @@ RENDERERS = {
     "fill-comparison": r_fill_comparison,
     "robust": r_robust,
     "bench": r_bench,
+    "physics-wall": r_physics_wall,
+    "physics-shear-factors": r_physics_shear_factors,
+    "physics-shear-effect": r_physics_shear_effect,
+    "physics-zhang-printed": r_physics_zhang_printed,
+    "physics-contact-data": r_physics_contact_data,
+    "physics-cavitation-offset": r_physics_cavitation_offset,
+    "physics-film-pressures": r_physics_film_pressures,
+    "physics-optimum-film-pressure": r_physics_optimum_film_pressure,
+    "physics-capacity": r_physics_capacity,
+    "physics-plausible": r_physics_plausible,
+    "physics-capacity-example": r_physics_capacity_example,
+    "physics-capacity-ratios": r_physics_capacity_ratios,
+    "physics-conduction": r_physics_conduction,
+    "physics-thermal": r_physics_thermal,
 }
 
 

@@ -841,9 +841,10 @@ def r_physics_film_pressures(n):
 
 def r_physics_optimum_film_pressure(n):
     rows = n["optimize_scenes"]["rows"]
-    z, b = (rows[name]["min_film_pressure_Pa"] for name in ("zhang2021", "bao2020"))
+    z, b = (None if rows[name]["min_film_pressure_Pa"] is None else rows[name]["min_film_pressure_Pa"] / 1e5
+            for name in ("zhang2021", "bao2020"))
     return (f"Lowest mean film pressure of the IDAS replay (`verification.idas.min_film_pressure_Pa`): "
-            f"{fmt(z / 1e5, 3)} bar for zhang2021's optimum, {fmt(b / 1e5, 3)} bar for bao2020's "
+            f"{fmt(z, 3)} bar for zhang2021's optimum, {fmt(b, 3)} bar for bao2020's "
             f"(`clutchocp optimize SCENE`; {measured(n, 'optimize_scenes')}).\n")
 
 

@@ -68,7 +68,7 @@ def test_linear_and_nonlinear_closed_loops_agree_on_a_one_percent_step(cases, sc
 @pytest.mark.parametrize("scene", SCENES)
 @pytest.mark.parametrize("name", ["lqi", "pi"])
 def test_done_when_targets_on_the_nonlinear_plant(cases, scene, name):
-    """Soft start, 40 -> 60 -> 90 % setpoint steps, +-20 % load steps (issue 5 'done when')."""
+    """Soft start, 40 -> 60 -> 90 % setpoint steps, +-20 % load steps."""
     model, spec, sched = cases[scene, name]
     run = simulate_closed_loop(model, sched.controller, make_scenario(model, spec))
     m = run.metrics

@@ -1,4 +1,4 @@
-"""Extreme cases: engagement scenes at the edges of the physics (issue 6).
+"""Extreme cases: engagement scenes at the edges of the physics.
 
 Every case is a built-in scene with a few values pushed to an edge (Scene.with_overrides). Each
 must either succeed -- energy balance <= 1e-6, no NaN anywhere, no lock/unlock chatter -- or fail
@@ -23,7 +23,7 @@ from clutchocp.errors import ClutchocpError, ModelEdgeError, PhysicalRangeError,
 from clutchocp.scene.loader import load_scene
 
 CAP_S = 20.0                       # wall-time cap of one run [s] (enforced by the engine)
-ENERGY_TOL = 1e-6                  # issue 6: energy balance <= 1e-6
+ENERGY_TOL = 1e-6                  # the energy balance every run must close to
 MAX_ROTATION_SWITCHES = 2          # e.g. an unlock at t = 0 and the lock-up; more would be chatter
 
 

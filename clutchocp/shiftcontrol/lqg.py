@@ -149,16 +149,22 @@ def _tcu_lqr(w, model, w_rel0, t_lock, p_range):
     With ``correction_rate_tolerance`` the input is the change of the correction, v = du - du_prev (du_prev is
     a state of the TCU): the weight on v smooths the correction from sample to sample, and
     ``correction_tolerance`` weighs du itself; the gains returned act on the correction, du = -K [xi; z].
+
+    The weight at the nominal lock-up is ``terminal_weight`` times the running one, or, with
+    ``terminal_slip_tolerance`` and ``terminal_slip_rate_tolerance``, Bryson's rule on the slip and the slip
+    rate there on their own (the integral keeps its running weight): the torque jump at lock-up is the
+    inertia times the slip rate there, so the rate can be weighed harder than the slip, whose tight weight
+    makes a slower clutch lock on time.
     """
     N, n = model.A.shape[0], model.A.shape[1]
     e_s, r_s, xi_s = abs(w_rel0), abs(w_rel0) / t_lock, abs(w_rel0) * t_lock
     j = model.names.index("du_prev")
     rate = w.get("correction_rate_tolerance")
 
-    def weight(slip_row, rate_row):
+    def weight(slip_row, rate_row, slip_tolerance=w["slip_tolerance"], rate_tolerance=w["slip_rate_tolerance"]):
         Q = np.zeros((n + 1, n + 1))
-        Q[:n, :n] = (np.outer(slip_row, slip_row) / (w["slip_tolerance"] * e_s) ** 2
-                     + np.outer(rate_row, rate_row) / (w["slip_rate_tolerance"] * r_s) ** 2)
+        Q[:n, :n] = (np.outer(slip_row, slip_row) / (slip_tolerance * e_s) ** 2
+                     + np.outer(rate_row, rate_row) / (rate_tolerance * r_s) ** 2)
         Q[n, n] = 1.0 / (w["integral_tolerance"] * xi_s) ** 2
         if rate:
             Q[j, j] = 1.0 / (w["correction_tolerance"] * p_range) ** 2
@@ -177,7 +183,12 @@ def _tcu_lqr(w, model, w_rel0, t_lock, p_range):
         Q.append(weight(model.slip_row[k], model.slip_rate_row[k]))
     tolerance = rate if rate else w["correction_tolerance"]
     R = [np.array([[1.0 / (tolerance * p_range) ** 2]])] * N
-    K, _ = tvlqr(A, B, Q, R, w["terminal_weight"] * weight(model.slip_row_end, model.slip_rate_end))
+    if w.get("terminal_slip_tolerance") is not None:
+        terminal = weight(model.slip_row_end, model.slip_rate_end, w["terminal_slip_tolerance"],
+                          w["terminal_slip_rate_tolerance"])
+    else:
+        terminal = w["terminal_weight"] * weight(model.slip_row_end, model.slip_rate_end)
+    K, _ = tvlqr(A, B, Q, R, terminal)
     K = K[:, 0, :]
     if rate:                          # v = -K_v [xi; z]: du = du_prev + v = -(K_v - e_du_prev) [xi; z]
         K[:, j] -= 1.0

@@ -20,6 +20,8 @@ field::
     correction_tolerance = 0.3       # feedback correction, fraction of the pressure range
     correction_rate_tolerance = 0.05 # kalman: change of the correction per sample, fraction of the pressure range
     terminal_weight = 10.0           # the state weights at lock-up are this many times larger
+    terminal_slip_tolerance = 0.002  # kalman, optional with the next: the weights at lock-up on their own,
+    terminal_slip_rate_tolerance = 0.05   # slip and slip rate at the nominal lock-up (instead of terminal_weight)
 
     [anti_windup]
     method = "clamping"              # or "none"
@@ -112,6 +114,8 @@ _LQI = {
     "correction_tolerance": ("1", "positive", 0.3),
     "correction_rate_tolerance": ("1", "positive", None),
     "terminal_weight": ("1", "nonnegative", 10.0),
+    "terminal_slip_tolerance": ("1", "positive", None),
+    "terminal_slip_rate_tolerance": ("1", "positive", None),
 }
 _ANTI_WINDUP = {"method": ("choice", ANTI_WINDUP, "clamping")}
 _ESTIMATOR = {"enabled": ("bool", None, False), "method": ("choice", ESTIMATORS, "difference"),
@@ -211,7 +215,15 @@ def parse_slip_spec(raw):
     if fraction > 1.0:
         raise PhysicalRangeError(f"feedforward.t_max_fraction = {fraction:g}: must be in (0, 1] (the closed loop's "
                                  "feedforward locks at this fraction of t_max or earlier)")
+    estimator = values["estimator"]
     weights = values["lqi"]
+    terminal = [key for key in ("terminal_slip_tolerance", "terminal_slip_rate_tolerance") if weights[key] is not None]
+    if len(terminal) == 1:
+        raise MissingParameterError(f"lqi.{terminal[0]}: give lqi.terminal_slip_tolerance and "
+                                    "lqi.terminal_slip_rate_tolerance together (the weights at lock-up) or neither")
+    if terminal and estimator["method"] != "kalman":
+        raise PhysicalRangeError("lqi.terminal_slip_tolerance and terminal_slip_rate_tolerance need estimator.method "
+                                 "= \"kalman\" (the difference design weighs lock-up with terminal_weight)")
     schedule = values["schedule"]
     points = schedule["points"]
     if points != int(points) or points > 25:
@@ -221,7 +233,6 @@ def parse_slip_spec(raw):
         raise PhysicalRangeError(f"schedule.field = {schedule['field']!r} needs feedforward.curve = \"nominal\" (the "
                                  "robust feedforward is one curve for every clutch); remove [schedule] or use the "
                                  "nominal curve")
-    estimator = values["estimator"]
     if not 0.0 < estimator["activation"] < 1.0:
         raise PhysicalRangeError(f"estimator.activation = {estimator['activation']:g}: must be in (0, 1) (a fraction "
                                  "of the nominal clutch torque's peak)")

@@ -98,24 +98,32 @@ def test_robust_feedforward_enters_the_strategy_list_when_installed(monkeypatch)
 
 def test_closed_loop_tracks_a_feedforward_with_a_time_margin_when_asked(monkeypatch):
     """feedforward.t_max_fraction < 1 (no robust feedforward): the nominal optimum strategy keeps t_max,
-    the closed loop tracks an optimum that locks at that fraction of t_max on the nominal clutch."""
+    the closed loop tracks an optimum that locks at that fraction of t_max on the nominal clutch. The fraction is
+    0.95: with the transmitted shear-factor table and cavitating films the fastest lock-up that meets the end
+    conditions on 30 intervals (a minimum-time solve) takes 0.1268 s = 0.939 t_max (measured), so a margin of
+    10 % has no solution; the premise is asserted first."""
     from dataclasses import replace
 
+    from clutchocp.optimal.problem import EngagementOCP
+    from clutchocp.optimal.strategy import FASTEST_WEIGHTS
     from clutchocp.shiftcontrol import workflow
     from clutchocp.shiftcontrol.spec import load_slip_spec
 
     monkeypatch.setattr(workflow, "robust_solver", lambda: None)
     scene = default_scene()
-    spec = replace(load_slip_spec(), t_max_fraction=0.9, schedule_field="")
+    fraction = 0.95
+    ocp = EngagementOCP(scene.without_uncertainty(), intervals=30)
+    assert ocp.solve(t_max=np.inf, weights=FASTEST_WEIGHTS).t_f < fraction * ocp.default_t_max()
+    spec = replace(load_slip_spec(), t_max_fraction=fraction, schedule_field="")
     strategies, facts = workflow.build_strategies(scene.without_uncertainty(), Uncertainty.from_scene(scene), spec,
                                                 intervals=30, say=lambda *a: None)
     t_max = facts["t_max_s"]
     assert [s.name for s in strategies] == ["baseline", "nominal_optimum", "closed_loop"]
     assert strategies[1].notes["t_lock_s"] == pytest.approx(t_max, rel=1e-6)
     assert facts["closed_loop"]["feedforward"] == "nominal_optimum_with_margin"
-    assert "0.9 t_max" in strategies[2].label
+    assert "0.95 t_max" in strategies[2].label
     # the IDAS replay of the tighter optimum locks where the collocation put it, within the lock-time tolerance
-    assert facts["closed_loop"]["nominal_lock_s"] == pytest.approx(0.9 * t_max, rel=0.01)
+    assert facts["closed_loop"]["nominal_lock_s"] == pytest.approx(fraction * t_max, rel=0.01)
 
 
 def test_closed_loop_is_scheduled_on_the_oil_viscosity(monkeypatch):

@@ -20,6 +20,8 @@ def test_tcu_spec_loads_its_sensors():
     assert spec.sensors["sump_temperature"]["oil_viscosity_40C"] == pytest.approx(80.12e-6)
     assert spec.estimated_parameters["driveline.input_torque"] == pytest.approx(0.05)
     assert spec.acceptance == {"lock_by_t_max": 1.03, "jump_p95_pct": 5.0, "jump_worst_pct": 10.0, "jerk_ratio": 1.15}
+    assert (spec.lqi["terminal_slip_tolerance"], spec.lqi["terminal_slip_rate_tolerance"]) == (0.002, 0.05)
+    assert load_slip_spec("slip_lqr").lqi["terminal_slip_tolerance"] is None       # terminal_weight there
 
 
 def test_builtin_spec_loads_with_units():
@@ -78,6 +80,12 @@ def test_builtin_spec_loads_with_units():
     ({"controller": {**GOOD["controller"], "progress": "slip"}, "estimator": {"enabled": True, "method": "kalman"}},
      r"estimator\.method = \"kalman\" needs controller\.progress = \"time\""),
     ({**GOOD, "acceptance": {"lock_by_t_max": 0.9}}, r"acceptance\.lock_by_t_max = 0\.9: must be >= 1"),
+    ({**KALMAN, "lqi": {"terminal_slip_tolerance": 0.01}},
+     r"lqi\.terminal_slip_tolerance: give lqi\.terminal_slip_tolerance and lqi\.terminal_slip_rate_tolerance together"),
+    ({**GOOD, "lqi": {"terminal_slip_tolerance": 0.01, "terminal_slip_rate_tolerance": 0.05}},
+     r"lqi\.terminal_slip_tolerance and terminal_slip_rate_tolerance need estimator\.method = \"kalman\""),
+    ({**KALMAN, "lqi": {"terminal_slip_tolerance": 0.01, "terminal_slip_rate_tolerance": -1}},
+     r"lqi\.terminal_slip_rate_tolerance = -1: must be > 0"),
 ])
 def test_bad_specs_raise_one_line(raw, match):
     with pytest.raises(SceneError, match=match) as info:

@@ -18,6 +18,7 @@ from ..optimal.replay import CommandModel, simulate_command
 from ..simulation import SimulationOptions, simulate
 from ..simulation.result import SimulationResult
 from .sensors import PressureSensor, Sensors
+from .tcu import clipped_command
 
 POINTS_PER_SAMPLE = 11       # output points per TCU sample (1 ms at 10 ms) for jerk integrals
 
@@ -135,7 +136,8 @@ def run_tcu_loop(scene, feedback, t_end, *, sensors=None, model=None, rtol=None,
     ``scene`` with its sensors and valve dead time, through lock-up, to ``t_end``.
 
     The plant's valve receives the TCU's output the dead time D_p later, so the plant is integrated in
-    pieces [t_k + D_p, t_k+1 + D_p] under u_ff(t - D_p + D) + du_k (D the dead time the TCU assumes);
+    pieces [t_k + D_p, t_k+1 + D_p] under u_ff(t - D_p + D) + du_k (D the dead time the TCU assumes), clipped
+    to the TCU's pressure limits (the valve's range);
     the sensors are fed the plant's speeds and pressure as they come and read at t_k. The TCU hands
     over to the clamp ramp once it has seen the measured slip within its lock-up threshold for its
     number of samples (or its design's horizon has run out); the ramp reaches the plant D_p later too.
@@ -204,7 +206,8 @@ def run_tcu_loop(scene, feedback, t_end, *, sensors=None, model=None, rtol=None,
         for name in params:
             estimates[name[2:]].append(feedback.estimate(name))
         t1 = min((k + 1) * Ts + D_p, t_end)
-        inputs = model.inputs(feedback.ff_times - feedback.advance + D_p, feedback.ff_values + du)
+        inputs = model.inputs(*clipped_command(feedback.ff_times - feedback.advance + D_p, feedback.ff_values + du,
+                                               feedback.p_min, feedback.p_max))
         mode, x = run_piece(t + D_p, t1, inputs, mode, x, extra=[(k + 1) * Ts] if (k + 1) * Ts < t1 else ())
         k += 1
     t_plant = k * Ts + D_p if handover is not None else None

@@ -75,6 +75,7 @@ field::
     [feedforward]
     curve = "nominal"                # the curve the loop tracks: "nominal" optimum or "robust" feedforward
     t_max_fraction = 1.0             # the nominal optimum is solved with t_max x this (a time margin)
+    pressure_reserve = "0 MPa"       # and with the pressure limit lowered by this (headroom for the loop)
 
     [schedule]                       # the TCU measures this field (the oil viscosity, from its temperature)
     field = "oil.viscosity"          # feedforward and gains designed at `points` values over its spread
@@ -138,7 +139,8 @@ _VALVE = {"dead_time": ("s", "nonnegative", 0.0), "assumed_dead_time": ("s", "no
 _LOCK = {"slip": ("rad/s", "nonnegative", None), "samples": ("1", "positive", 2.0)}
 _ACCEPTANCE = {"lock_by_t_max": ("1", "positive", 1.01), "jump_p95_pct": ("1", "positive", 3.0),
                "jump_worst_pct": ("1", "positive", 6.0), "jerk_ratio": ("1", "positive", 1.15)}
-_FEEDFORWARD = {"curve": ("choice", CURVES, "nominal"), "t_max_fraction": ("1", "positive", 1.0)}
+_FEEDFORWARD = {"curve": ("choice", CURVES, "nominal"), "t_max_fraction": ("1", "positive", 1.0),
+                "pressure_reserve": ("Pa", "nonnegative", 0.0)}
 _SCHEDULE = {"field": ("str", None, ""), "points": ("1", "positive", 1.0)}
 _TABLES = {"controller": _CONTROLLER, "lqi": _LQI, "anti_windup": _ANTI_WINDUP, "estimator": _ESTIMATOR,
            "feedforward": _FEEDFORWARD, "schedule": _SCHEDULE, "sensors": _SENSORS, "valve": _VALVE, "lock": _LOCK,
@@ -164,6 +166,7 @@ class SlipControlSpec:
     estimator: dict = field(default_factory=lambda: {k: v[2] for k, v in _ESTIMATOR.items()})
     feedforward_curve: str = "nominal"
     t_max_fraction: float = 1.0
+    pressure_reserve: float = 0.0
     schedule_field: str = ""
     schedule_points: int = 1
     sensors: dict = field(default_factory=dict)           # [sensors.*] tables given (SI), by sub-table
@@ -215,6 +218,10 @@ def parse_slip_spec(raw):
     if fraction > 1.0:
         raise PhysicalRangeError(f"feedforward.t_max_fraction = {fraction:g}: must be in (0, 1] (the closed loop's "
                                  "feedforward locks at this fraction of t_max or earlier)")
+    reserve = values["feedforward"]["pressure_reserve"]
+    if reserve > 0 and values["feedforward"]["curve"] == "robust":
+        raise PhysicalRangeError(f"feedforward.pressure_reserve = {reserve:g} Pa needs feedforward.curve = "
+                                 "\"nominal\" (the reserve lowers the nominal optimum's pressure limit)")
     estimator = values["estimator"]
     weights = values["lqi"]
     terminal = [key for key in ("terminal_slip_tolerance", "terminal_slip_rate_tolerance") if weights[key] is not None]
@@ -277,6 +284,7 @@ def parse_slip_spec(raw):
                            progress=c["progress"], max_delay=c["max_delay"],
                            lqi=weights, anti_windup=values["anti_windup"]["method"], estimator=estimator,
                            feedforward_curve=values["feedforward"]["curve"], t_max_fraction=fraction,
+                           pressure_reserve=reserve,
                            schedule_field=schedule["field"], schedule_points=int(points), sensors=sensors,
                            valve=valve, lock=lock, estimated_parameters=parameters,
                            acceptance=values["acceptance"])

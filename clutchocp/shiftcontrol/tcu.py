@@ -18,7 +18,8 @@ A tooth-wheel reading is the mean speed over its window, i.e. the speed at the w
 the TCU knows from its stamps (``y_time``); the model's reading stands for the nominal middle
 (``t_ref``): the difference times the nominal acceleration (``rate_ref``) moves it there.
 u_ff,k is the feedforward at t_k + D (D: the valve dead time the TCU assumes; it sends its command
-that much early); between samples the TCU's output is u_ff(t + D) + du_k. The lock-up counter counts
+that much early); between samples the TCU's output is clip(u_ff(t + D) + du_k, p_min, p_max) (the valve
+cannot leave its range, :func:`clipped_command`). The lock-up counter counts
 the samples in a row with the measured slip within ``lock_slip``; at ``lock_samples`` the TCU hands
 over to the clamp ramp. :func:`step_function` is that law as one CasADi function of the sample's
 table rows (:meth:`TCUFeedback.row`): :meth:`TCUFeedback.step` calls it, and
@@ -36,6 +37,24 @@ STEP_INPUTS = ("y", "y_time", "y_ref", "t_ref", "rate_ref", "x_prior", "integral
                "M", "C", "K", "A", "B", "slip_row", "dt", "u_ff", "limits")
 STEP_OUTPUTS = ("u", "du", "u_unsat", "x_post", "x_next", "integral_next", "lock_count_next")
 LIMITS = ("p_min", "p_max", "reach", "clamping", "lock_slip")
+
+
+def clipped_command(times, values, p_min, p_max):
+    """A piecewise-linear command clipped to [p_min, p_max], exactly: (times, values) [s], [Pa].
+
+    Each segment that crosses a limit gets the crossing time as a new point, so the clipped command is
+    again piecewise linear through its points (a crossing that falls on a point within round-off is dropped).
+    """
+    times, values = np.asarray(times, float), np.asarray(values, float)
+    t_out, v_out = [times[0]], [values[0]]
+    for t0, t1, v0, v1 in zip(times[:-1], times[1:], values[:-1], values[1:]):
+        crossings = sorted((t0 + (level - v0) / (v1 - v0) * (t1 - t0), level) for level in (p_min, p_max)
+                           if (v0 - level) * (v1 - level) < 0)      # the segment strictly crosses the level
+        t_out += [t for t, _ in crossings] + [t1]
+        v_out += [level for _, level in crossings] + [v1]
+    t_out, v_out = np.asarray(t_out), np.clip(np.asarray(v_out), p_min, p_max)
+    keep = np.concatenate([[True], np.diff(t_out) > 1e-12 * max(1.0, abs(t_out[-1]))])  # a crossing at a point
+    return t_out[keep], v_out[keep]
 
 
 @functools.lru_cache(maxsize=16)

@@ -15,7 +15,7 @@ import warnings
 
 import numpy as np
 
-from ..errors import ModelError, SolverError
+from ..errors import ModelError, PhysicalRangeError, SolverError
 from ..optimal.baselines import baseline_label
 from ..optimal.problem import EngagementOCP
 from ..optimal.robust import lock_diagonal, solve_robust
@@ -139,8 +139,18 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         say(f"  nominal optimum for the closed loop at {spec.t_max_fraction:g} x t_max = "
             f"{spec.t_max_fraction * t_max:.4g} s")
         feedforward = ("nominal_optimum_with_margin",) + feedforward[1:]
-    ff_label = ("nominal optimum" if margin else feedforward[0].replace("_", " ")) \
-        + (f" at {spec.t_max_fraction:g} t_max" if margin else "")
+    reserve = spec.pressure_reserve if feedforward[0] != "robust_feedforward" else 0.0
+    if reserve > 0:
+        p_top = pressure_limits(scene, spec)[1]
+        if reserve >= p_top:
+            raise PhysicalRangeError(f"feedforward.pressure_reserve = {reserve / 1e6:g} MPa: must be below the "
+                                     f"loop's pressure limit {p_top / 1e6:g} MPa")
+        # the feedforward keeps a pressure reserve for the feedback: its optimum is solved with the limit lowered
+        say(f"  nominal optimum for the closed loop with a pressure reserve of {reserve / 1e6:g} MPa "
+            f"(limit {(p_top - reserve) / 1e6:g} MPa)")
+    ff_label = ("nominal optimum" if margin or reserve > 0 else feedforward[0].replace("_", " ")) \
+        + (f" at {spec.t_max_fraction:g} t_max" if margin else "") \
+        + (f" with a {reserve / 1e6:g} MPa reserve" if reserve > 0 else "")
 
     def feedforward_for(design_scene):
         # the closed loop's feedforward on a design scene: the curve chosen above on the nominal scene,
@@ -148,8 +158,11 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         if feedforward[0] == "robust_feedforward":
             return feedforward[1], feedforward[2]
         same = design_scene is scene
-        problem = ocp if same else EngagementOCP(design_scene, intervals=intervals)
-        if same and not margin:
+        if reserve > 0:
+            top = pressure_limits(design_scene, spec)[1] - reserve
+            design_scene = design_scene.with_overrides({"actuation.max_pressure": top})
+        problem = ocp if same and reserve == 0 else EngagementOCP(design_scene, intervals=intervals)
+        if same and not margin and reserve == 0:
             return opt.command_times, opt.command
         found = problem.solve(t_max=spec.t_max_fraction * t_max, guess=opt if same else None)
         return found.command_times, found.command

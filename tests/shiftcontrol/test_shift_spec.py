@@ -40,6 +40,9 @@ def test_builtin_spec_loads_with_units():
     assert parse_slip_spec({**GOOD, "feedforward": {"t_max_fraction": 0.85}}).t_max_fraction == pytest.approx(0.85)
     assert spec.feedforward_curve == "nominal"
     assert parse_slip_spec({**GOOD, "feedforward": {"curve": "robust"}}).feedforward_curve == "robust"
+    assert spec.pressure_reserve == 0.0
+    assert parse_slip_spec({**GOOD, "feedforward": {"pressure_reserve": "0.2 MPa"}}).pressure_reserve == \
+        pytest.approx(2e5)
 
 
 @pytest.mark.parametrize("raw, match", [
@@ -57,6 +60,9 @@ def test_builtin_spec_loads_with_units():
     ({**GOOD, "feedforward": {"t_max_fraction": 1.2}}, r"feedforward\.t_max_fraction = 1\.2: must be in \(0, 1\]"),
     ({**GOOD, "feedforward": {"t_max_fraction": 0}}, r"feedforward\.t_max_fraction = 0: must be > 0"),
     ({**GOOD, "feedforward": {"curve": "best"}}, r"feedforward\.curve.*nominal, robust"),
+    ({**GOOD, "feedforward": {"pressure_reserve": "-0.1 MPa"}}, r"feedforward\.pressure_reserve = '-0\.1 MPa'"),
+    ({**GOOD, "feedforward": {"pressure_reserve": "0.1 MPa", "curve": "robust"}},
+     r"feedforward\.pressure_reserve = 100000 Pa needs feedforward\.curve = \"nominal\""),
     ({**GOOD, "feedforward": {"t_max_fracton": 0.9}}, r"feedforward\.t_max_fracton: unknown key .*did you mean 't_max_fraction'"),
     ({**GOOD, "estimator": {"activation": 1.5}}, r"estimator\.activation = 1\.5: must be in \(0, 1\)"),
     ({**GOOD, "estimator": {"gain_limit": 0.8}}, r"estimator\.gain_limit = 0\.8: must be above 1"),

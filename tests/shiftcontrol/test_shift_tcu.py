@@ -17,7 +17,7 @@ from clutchocp.shiftcontrol.lqg import _tcu_lqr, design_tcu_feedback
 from clutchocp.shiftcontrol.schedule import FeedbackSchedule
 from clutchocp.shiftcontrol.sensors import Sensors, sensors_from_spec
 from clutchocp.shiftcontrol.spec import load_slip_spec
-from clutchocp.shiftcontrol.tcu import STEP_INPUTS, STEP_OUTPUTS
+from clutchocp.shiftcontrol.tcu import STEP_INPUTS, STEP_OUTPUTS, clipped_command
 
 INITIAL = {"w_in": 300.0, "w_out": 150.0, "p_valve": 0.0}
 
@@ -30,6 +30,16 @@ def designed():
     sensors = sensors_from_spec(spec, scene)
     design = design_tcu_feedback(scene, opt.command_times, opt.command, spec, sensors)
     return scene, opt, spec, sensors, design
+
+
+def test_clipped_command_is_the_clipped_piecewise_linear_curve():
+    """The clipped command's points, interpolated, equal np.clip of the original curve on a dense grid (crossings of
+    both limits within one segment, a segment inside, a point on a limit), and its times increase strictly."""
+    times, values = [0.0, 1.0, 2.0, 2.5, 3.0, 4.0], [-1.0, 3.0, 0.0, 2.0, 1.0, 1.0]
+    t, v = clipped_command(times, values, 0.0, 2.0)
+    grid = np.linspace(0.0, 4.0, 4001)
+    assert np.all(np.diff(t) > 0)
+    assert np.interp(grid, t, v) == pytest.approx(np.clip(np.interp(grid, times, values), 0.0, 2.0), abs=1e-12)
 
 
 def _jump_pct(numbers):

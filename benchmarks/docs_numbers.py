@@ -454,6 +454,34 @@ def robust(item):
             "samples_per_s": s["timing"]["samples_per_s"], "keys": folder_keys(run.folder)}
 
 
+TCU_UNCERTAIN = ("actuation.time_constant=uniform 20 %", "driveline.input_torque=uniform 5 %")
+
+
+def tcu_acceptance(item):
+    """The TCU loop's acceptance run: ``slip_lqr_tcu`` closed loop, 100 draws of the box plus the valve lag
+    and the engine torque the TCU is not told."""
+    args = ["robust", "--controller", "slip_lqr_tcu", "--strategies", "closed_loop", "--samples", "100",
+            "--seed", "11", "--workers", "2"]
+    for field in TCU_UNCERTAIN:
+        args += ["--uncertain", field]
+    run = item.clutchocp(*args)
+    s = summary_of(run.folder)
+    written = sorted(p.name for p in run.folder.iterdir() if p.suffix in (".c", ".h", ".csv", ".json"))
+    return {"command": "clutchocp " + " ".join(f'"{a}"' if " " in a else a for a in args) + " --out DIR",
+            "t_max_s": s["t_max_s"], "acceptance": s["acceptance"]["closed_loop"],
+            "statistics": s["statistics"]["closed_loop"], "timing": s["timing"], "written": written}
+
+
+def tcu_heldout(item):
+    """``benchmarks/bench_tcu_heldout.py``: the old loop and the TCU loop on conditions they were not designed for."""
+    code = ("import runpy, sys; sys.argv = ['bench_tcu_heldout.py', '--samples', '20', '--seed', '5', "
+            f"'--workers', '2', '--out', '.']; runpy.run_path({str(ROOT / 'benchmarks' / 'bench_tcu_heldout.py')!r}, "
+            "run_name='__main__')")
+    run = item.python(code, "tcu_heldout")
+    data = json.loads((run.folder / "heldout.json").read_text())
+    return {"command": "python benchmarks/bench_tcu_heldout.py --samples 20 --seed 5 --workers 2", **data}
+
+
 def bench(item):
     """``clutchocp bench --quick``: IDAS against scipy's integrators at matched error."""
     run = item.clutchocp("bench", "--quick")
@@ -543,15 +571,17 @@ ITEMS = {
     "sweep": sweep,
     "optimize_scenes": optimize_scenes,
     "robust": robust,
+    "tcu_acceptance": tcu_acceptance,
+    "tcu_heldout": tcu_heldout,
     "bench": bench,
 }
 # Priority of an item's commands when two wait for a slot: the longest first, so that the two slots
 # finish together (robust ~35 %, bench and optimize_scenes ~25 % each of the commands' time).
-ORDER = ("robust", "optimize_scenes", "bench", "optimize_weights", "sweep", "control", "optimize_default",
+ORDER = ("robust", "optimize_scenes", "bench", "tcu_heldout", "tcu_acceptance", "optimize_weights", "sweep", "control", "optimize_default",
          "simulate_scenes", "physics", "cycles", "readme_example", "validate")
 KEYS_OF = {"optimize": ("optimize_default", "optimize_scenes"), "simulate": ("simulate_scenes",),
            "cycles": ("cycles",), "validate": ("validate",), "control": ("control",), "sweep": ("sweep",),
-           "robust": ("robust",), "bench": ("bench",)}
+           "robust": ("robust", "tcu_acceptance"), "bench": ("bench",)}
 
 
 # -- examples in the docs --------------------------------------------------------------------------
@@ -753,6 +783,39 @@ def r_robust(n):
             + f"\nt_max = {fmt(d['t_max_s'])} s; acceptance: {accept}. (`{d['command']}`; {measured(n, 'robust')}.)\n")
 
 
+def r_tcu_acceptance(n):
+    d = n["tcu_acceptance"]
+    a, st, tm = d["acceptance"], d["statistics"], d["timing"]
+    lim = a["limits"]
+    jump = st["jump_pct"]
+    rows = [("every draw locks by this x t_max", fmt(lim["lock_by_t_max"], 3),
+             f"{pct(a['lock_by_limit_share'])} of the draws (the latest at {fmt(a['latest_lock_over_t_max'], 4)})"),
+            ("\\|jump\\| p95 [% of locked torque]", fmt(lim["jump_p95_pct"], 3), fmt(a["jump_p95_pct"], 3)),
+            ("\\|jump\\| worst [% of locked torque]", fmt(lim["jump_worst_pct"], 3), fmt(a["jump_worst_pct"], 3)),
+            ("nominal jerk integral / the nominal optimum's", fmt(lim["nominal_jerk_over_nominal_optimum"], 3),
+             fmt(a["nominal_jerk_over_nominal_optimum"], 3))]
+    return (table(("target", "limit", "measured"), rows)
+            + f"\nt_max = {fmt(d['t_max_s'])} s; {pct(st['lock_within_t_max_share'])} of the draws lock within t_max; "
+              f"\\|jump\\| median {fmt(jump['median'], 3)} %; targets met: {fmt(bool(a['passed']))}. "
+              f"{fmt(tm['monte_carlo_s'], 3)} s of Monte Carlo ({fmt(tm['samples_per_s'], 3)} samples/s on "
+              f"{tm['workers']} processes) after {fmt(tm['setup_s'], 3)} s of set-up. The folder holds "
+              f"{', '.join('`' + f + '`' for f in d['written'])}. (`{d['command']}`; {measured(n, 'tcu_acceptance')}.)\n")
+
+
+def r_tcu_heldout(n):
+    d = n["tcu_heldout"]
+
+    def cells(s):
+        if s is None:
+            return ["-", "- (exact readings only)"]
+        return [pct(s["within_t_max"]), " / ".join(fmt(s[k], 3) for k in ("jump_median_pct", "jump_p95_pct",
+                                                                          "jump_worst_pct"))]
+    rows = [(label, *cells(r.get("old")), *cells(r.get("tcu"))) for label, r in d["results"].items()]
+    return (table(("condition", "old loop: within t_max", "old: \\|jump\\| % median / p95 / worst",
+                   "TCU loop: within t_max", "TCU: \\|jump\\| % median / p95 / worst"), rows)
+            + f"\n({d['samples']} draws per condition; `{d['command']}`; {measured(n, 'tcu_heldout')}.)\n")
+
+
 def r_bench(n):
     s = n["bench"]["summary"]
     scenes = s.get("scenes") or {k: v for k, v in s.items() if isinstance(v, dict) and "speedup_vs_radau" in v}
@@ -918,6 +981,8 @@ RENDERERS = {
     "optimize-scenes": r_optimize_scenes,
     "fill-comparison": r_fill_comparison,
     "robust": r_robust,
+    "tcu-acceptance": r_tcu_acceptance,
+    "tcu-heldout": r_tcu_heldout,
     "bench": r_bench,
     "physics-wall": r_physics_wall,
     "physics-shear-factors": r_physics_shear_factors,

@@ -225,6 +225,20 @@ def test_a_profile_pressing_beyond_the_contact_is_held_within_it_for_the_baselin
         == (plain, None)
 
 
+def test_a_pressure_table_pressing_beyond_the_contact_is_refused_in_one_line(tmp_path):
+    """A table is the user's own profile: it is not changed for the baseline but refused, naming the capacity."""
+    table = tmp_path / "pressure.csv"
+    table.write_text("t_s,p_Pa\n0,0\n0.05,8e5\n", encoding="utf-8")
+    scene = default_scene().with_overrides({"roughness.sigma_1": 6e-6, "actuation.model": "table",
+                                            "actuation.file": str(table),
+                                            "actuation.time_constant": None})
+    model = EngagementModel(scene, pressure_command=ca.SX.sym("u"))
+    with pytest.raises(PhysicalRangeError) as info:
+        own_profile_within_contact(scene, model, 1.5e6)
+    message = str(info.value)
+    assert "\n" not in message and "contact capacity" in message and "0.771 MPa" in message
+
+
 def test_a_clamp_margin_the_pack_cannot_hold_names_the_largest():
     scene = default_scene().with_overrides({"roughness.sigma_1": 5e-6})
     clamp = ClampModel(scene)

@@ -48,8 +48,8 @@ import casadi as ca
 import numpy as np
 from scipy.linalg import expm
 
-from ..engagement.edges import zero_gap_pressure
-from ..errors import ModelError
+from ..engagement.edges import check_contact_capacity, zero_gap_pressure
+from ..errors import ModelError, PhysicalRangeError
 
 FILM_FLOOR = 0.02         # films >= FILM_FLOOR x sigma where the contact cannot carry the pressure limit at zero gap
 
@@ -101,6 +101,58 @@ def usable_pressure(model, p_max):
     F0 = plate_force(model, 0.0)
     slope = plate_force(model, 1.0) - F0                 # the plate force is affine in the pressure [N/Pa]
     return float(np.clip((target - F0) / slope, 0.0, p_max))
+
+
+def own_profile_within_contact(scene, model, p_max):
+    """The scene whose own pressure profile starts the optimiser, and a note where it is not ``scene``'s.
+
+    A scene's own profile may press the pack harder than its asperity contact carries at zero gap: its
+    run is refused before it starts (:func:`~clutchocp.engagement.edges.check_contact_capacity`), while
+    commands the contact can carry may still lock the clutch (the holding capacity is checked by
+    :func:`check_pack`). The optimiser's baseline is then the same profile with its pressures held
+    within the contact: at most :func:`usable_pressure` (the command whose settled plate pressure the
+    contact carries at the film floor), or for a spring-applied piston at least that oil pressure.
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+    model : clutchocp.engagement.model.EngagementModel
+        The scene's model (its film law and piston).
+    p_max : float
+        The pressure limit [Pa].
+
+    Returns
+    -------
+    (clutchocp.scene.Scene, str or None)
+        The scene to simulate as the baseline and, if its pressures were changed, one line saying how.
+
+    Raises
+    ------
+    PhysicalRangeError
+        A pressure table (``actuation.model = "table"``) that presses harder than the contact carries:
+        one line naming the capacity (the table is the user's to change).
+    """
+    try:
+        check_contact_capacity(scene)
+        return scene, None
+    except PhysicalRangeError as err:
+        refusal = err
+    if scene.variant("actuation") == "table":
+        raise PhysicalRangeError(f"scene '{scene.name}': contact capacity: {refusal}") from None
+    usable = usable_pressure(model, p_max)
+    pick = max if spring_applied(model) else min
+    keys = ("actuation.pressure", "actuation.initial_pressure")
+    held = scene.with_overrides({key: pick(scene.value(key), usable) for key in keys})
+    try:
+        capacity, _ = check_contact_capacity(held)
+    except PhysicalRangeError:
+        raise PhysicalRangeError(f"scene '{scene.name}': contact capacity: {refusal}") from None
+    side = "at least" if spring_applied(model) else "at most"
+    note = (f"the scene's own profile (actuation.pressure {scene.value('actuation.pressure') / 1e6:.4g} MPa) presses "
+            f"harder than the contact carries at zero gap ({capacity.pressure_Pa / 1e6:.4g} MPa); the baseline is "
+            f"that profile {side} {usable / 1e6:.4g} MPa, the command whose plate pressure the contact carries at "
+            f"a film of {FILM_FLOOR:g} sigma")
+    return held, note
 
 
 def lock_state(model):

@@ -177,7 +177,9 @@ def solve_verified(ocp, *, refinements=MAX_REFINEMENTS, command_model=None, say=
             f"{_pct(check['torque_jump_rel'])}): grading the mesh from the interval defects and solving again")
         refined = ocp.refined(opt)
         try:
-            opt_new = refined.solve(**dict(solve_kwargs, guess=opt))
+            # with the barrier update that reached the optimum it starts from (bao2020_as_published: the
+            # adaptive update stopped at its iteration limit on the graded mesh where the optimum was monotone's)
+            opt_new = refined.solve(**dict(solve_kwargs, guess=opt, barrier=strategy["solve"].get("barrier", "adaptive")))
         except SolverError as exc:         # keep the last optimum; its check says it missed
             say(f"  the solve on the graded mesh failed ({exc}); keeping the previous optimum")
             history.append({"stage": "graded mesh", "graded": True, "failed": str(exc)})

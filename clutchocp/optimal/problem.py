@@ -85,7 +85,8 @@ from .bound import jerk_lower_bound, output_jerk_share
 from .collocation import DirectCollocation, StagedProblem
 from .derivatives import MUMPS_UNSCALED, nlp_solver
 from .feasibility import (FILM_FLOOR, check_heat, check_pack, film_floor, hardest_command, holding_capacity,
-                          locked_torque_at_lock, plate_force, spring_applied, usable_pressure)
+                          locked_torque_at_lock, own_profile_within_contact, plate_force, spring_applied,
+                          usable_pressure)
 from .guess import guess_from_optimum, guess_from_run
 from .heat import heat_limits
 from .mesh import graded_mesh, interval_defects
@@ -292,7 +293,9 @@ class EngagementOCP:
         floor = film_floor(self.model.film, plate_force(self.model, hardest_command(self.model, self.p_max))
                            / self.model.film.area)
         self.h_min = max(h_min or 0.0, floor) or h_min
-        self.baseline = baseline if baseline is not None else simulate_engagement(scene)
+        # the scene's own profile, held within what the contact carries at zero gap where it presses harder
+        self.baseline_scene, self.baseline_note = own_profile_within_contact(scene, self.model, self.p_max)
+        self.baseline = baseline if baseline is not None else simulate_engagement(self.baseline_scene)
         self._fastest = None
         # The run that seeds the first solve and sets the scales: the baseline if it locks up.
         self.reference_run = self.baseline if self.baseline.summary["engagement_time_s"] is not None \

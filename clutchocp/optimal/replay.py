@@ -5,6 +5,7 @@ event detection), to find the fastest lock-up the pressure limit allows and for 
 """
 
 import time
+from dataclasses import replace
 
 import casadi as ca
 import numpy as np
@@ -14,7 +15,6 @@ from ..engagement.run import EngagementResult, summarize
 from ..errors import ModelError
 from .quiet import native_output_caught
 from ..simulation import (
-    Event,
     HybridModel,
     Mode,
     PiecewiseConstant,
@@ -92,9 +92,10 @@ def _linear_command(model, u):
         outputs = {name: sub(expr) for name, expr in mode.outputs.items()}
         a_out = mode.outputs["output_acceleration_rad_s2"]
         outputs["output_jerk_rad_s3"] = sub(mode.outputs["output_jerk_rad_s3"] + ca.jacobian(a_out, u) * slope)
-        events = [Event(e.name, sub(e.function), e.target, e.direction,
-                        {k: sub(v) for k, v in e.reset.items()} if e.reset else None,
-                        sub(e.guard) if e.guard is not None else None, e.scale) for e in mode.events]
+        # every field carried over: an edge (a film gap reaching zero) stays an edge, not a switch into
+        # the same mode (which chattered when a held command pressed a locked pack beyond the contact)
+        events = [replace(e, function=sub(e.function), reset={k: sub(v) for k, v in e.reset.items()} if e.reset else None,
+                          guard=sub(e.guard) if e.guard is not None else None) for e in mode.events]
         modes.append(Mode(mode.name, mode.x, [sub(e) for e in mode.ode], outputs=outputs, events=events,
                           x_nominal=dict(zip(mode.x, mode.x_nominal))))
     return HybridModel(modes, u={"command_offset": offset, "command_slope": slope}, t=model.t)

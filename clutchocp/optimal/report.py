@@ -127,6 +127,8 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
     ocp = EngagementOCP(scene, intervals=intervals, degree=degree, max_temperature_C=max_temperature_C,
                         max_specific_power_W_mm2=max_specific_power_W_mm2)
     build_time = time.perf_counter() - start
+    if ocp.baseline_note:
+        say(f"  {ocp.baseline_note}")
     if ocp.holds_torque:          # the clamp after lock-up must be within reach before a solve is spent
         clamp_margin = _reachable_margin(ocp, clamp_margin, margin_given, say)
     command_model = ocp.models.replay(ocp.transcription.control)
@@ -145,7 +147,7 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
     curve, whole = _clamp_curve(scene, ocp, opt, command_model, clamp_margin)
     say(f"  after lock-up: ramp to the clamp pressure {curve.clamp_pressure_Pa / 1e6:.4g} MPa by "
         f"{curve.ramp_end_s:.4g} s ({curve.basis}); lock held in the IDAS replay: {whole['lock_held']}")
-    baselines = simulate_baselines(scene)
+    baselines = simulate_baselines(ocp.baseline_scene)
     w_rel0, rate0 = ocp.initial_slip()
     bound = jerk_lower_bound(w_rel0, rate0, opt.t_f)
     sweep = _sweep(ocp, opt, sorted(sweep_t_max), weights, say) if sweep_t_max is not None and len(sweep_t_max) else None
@@ -154,7 +156,8 @@ def optimize_scene(scene=None, *, t_max=None, weights=None, intervals=100, degre
         "scene": scene.name,
         "optimal": {k: opt.terms[k] for k in KEYS + ("slip_jerk_integral", "min_film_pressure_Pa")},
         "film_cavitation_pressure_Pa": ocp.model.film.cavitation_pressure,
-        "baseline": dict(run_numbers(ocp.baseline), profile=baseline_label(scene)),
+        "baseline": dict(run_numbers(ocp.baseline), profile=baseline_label(ocp.baseline_scene),
+                         **({"note": ocp.baseline_note} if ocp.baseline_note else {})),
         "baselines": {name: numbers for name, (_, numbers) in baselines.items()},
         "verification": {k: check[k] for k in ("lock_time_rel_diff", "lock_time_resolution_s", "torque_jump_Nm",
                                               "jump_reference_Nm",

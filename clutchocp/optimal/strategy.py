@@ -7,12 +7,14 @@ ends at a local point of infeasibility or at its iteration limit. :func:`solve_r
 
 0. after a NaN at a trial point (a film at the model's edge, h = 0) keeps the films above a floor
    (:meth:`~clutchocp.optimal.problem.EngagementOCP.floor_films`), as it does before step 2;
-   where IPOPT stalled (its iteration limit, a NaN, a failed step) rather than ending at a local
-   point of infeasibility, solves again from the same start with the monotone (Fiacco-McCormick)
-   update of the barrier parameter, and uses it in the steps below. Measured on the catalogue's
-   tractor_powershift_fill_60C (60 slip intervals): the adaptive update drove the barrier to 1e-11
-   within 100 iterations and crept along to the iteration limit (500, objective 3.49); the monotone
-   one converged in 209 iterations to 2.12;
+   solves again from the same start with the monotone (Fiacco-McCormick) update of the barrier
+   parameter, and uses it in the steps below, after a stall (its iteration limit, a NaN, a failed step)
+   and after a local point of infeasibility alike (IPOPT's local verdict; the limits were checked before
+   solving). Measured on the catalogue's tractor_powershift_fill_60C (60 slip intervals): the adaptive
+   update drove the barrier to 1e-11 within 100 iterations and crept along to the iteration limit (500,
+   objective 3.49); the monotone one converged in 209 iterations to 2.12. On bao2020_as_published (60 slip
+   intervals, t_max 1.188 s) the adaptive update ended at a local point of infeasibility after 257
+   iterations, the monotone one converged from the same start in 208;
 
 1. **relaxes the end condition**: the same problem with the lock-up jump as a penalty
    (:data:`RELAXED_JUMP_WEIGHT`) instead of a constraint is feasible from any start that locks up,
@@ -60,8 +62,9 @@ def solve_robustly(ocp, *, t_max=None, weights=None, e_max=None, guess=None, say
     Returns
     -------
     (OptimalEngagement, float, dict)
-        The optimum, the t_max it was solved for and how: ``{"t_max_source", "attempts"}`` (each
-        attempt: ``stage``, ``status``, ``iterations``, ``wall_time_s``; the fastest lock-up's time).
+        The optimum, the t_max it was solved for and how: ``{"t_max_source", "attempts", "barrier"}``
+        (each attempt: ``stage``, ``status``, ``iterations``, ``wall_time_s``; the fastest lock-up's time;
+        the barrier update of the solve that reached the optimum).
 
     Raises
     ------
@@ -88,6 +91,7 @@ def solve_robustly(ocp, *, t_max=None, weights=None, e_max=None, guess=None, say
             return None
         info["attempts"].append({"stage": stage, "status": result.stats["status"],
                                  "iterations": result.stats["iterations"], "wall_time_s": result.stats["wall_time_s"]})
+        info["barrier"] = kwargs.get("barrier", "adaptive")      # the update that reached this optimum
         return result
 
     opt = attempt("solve", ocp, t_max=t_max, weights=weights, guess=guess)
@@ -96,14 +100,14 @@ def solve_robustly(ocp, *, t_max=None, weights=None, e_max=None, guess=None, say
     barrier = "adaptive"
     if info["attempts"][-1]["status"] == "Invalid_Number_Detected":
         ocp.floor_films()                 # a NaN at a trial point: a film at the model's edge
-    if info["attempts"][-1]["status"] != "Infeasible_Problem_Detected":
-        # not a verdict on the limits but a stall: the same start with the steadier barrier update
-        barrier = "monotone"
-        say(f"  no optimum from the scene's own engagement as a start ({_last(info)}); again with IPOPT's "
-            f"monotone barrier update")
-        opt = attempt("solve (monotone barrier)", ocp, t_max=t_max, weights=weights, guess=guess, barrier=barrier)
-        if opt is not None:
-            return opt, t_max, info
+    # a stall, or a local point of infeasibility (IPOPT's local verdict, not one on the limits): the same
+    # start with the steadier barrier update
+    barrier = "monotone"
+    say(f"  no optimum from the scene's own engagement as a start ({_last(info)}); again with IPOPT's "
+        f"monotone barrier update")
+    opt = attempt("solve (monotone barrier)", ocp, t_max=t_max, weights=weights, guess=guess, barrier=barrier)
+    if opt is not None:
+        return opt, t_max, info
     say(f"  no optimum from the scene's own engagement as a start ({_last(info)}); solving with the lock-up jump "
         f"as a penalty first")
     relaxed = attempt("relaxed (jump as a penalty)", ocp.relaxed(), t_max=t_max,

@@ -82,10 +82,14 @@ def jump_reference(ocp, numbers):
 
 
 def holding_pressure(ocp, opt):
-    """Command after lock-up [Pa]: the larger of the last command and the scene's set pressure (the
-    smaller for a spring-applied piston, where pressure releases the clutch)."""
-    pick = min if ocp.spring_applied else max
-    return float(pick(opt.command[-1], ocp.scene.value("actuation.pressure")))
+    """Command after lock-up [Pa]: the larger of the last command and the set pressure of the baseline's
+    profile (the smaller for a spring-applied piston, where pressure releases the clutch); that profile
+    is the scene's own, held within what the contact carries at zero gap (``ocp.baseline_scene``). Where
+    the contact cannot carry the pressure limit, no more than the command it carries at the film floor
+    (``ocp.apply_pressure``; a spring-applied piston: no less): a locked pack pressed harder closes a film."""
+    if ocp.spring_applied:
+        return float(max(min(opt.command[-1], ocp.baseline_scene.value("actuation.pressure")), ocp.apply_pressure))
+    return float(min(max(opt.command[-1], ocp.baseline_scene.value("actuation.pressure")), ocp.apply_pressure))
 
 
 def located_lock_time(run):

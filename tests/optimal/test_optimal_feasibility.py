@@ -11,17 +11,18 @@ from scipy.integrate import quad
 
 from clutchocp.engagement.model import EngagementModel
 from clutchocp.engagement.run import simulate_engagement
-from clutchocp.errors import ModelError
+from clutchocp.errors import ModelError, PhysicalRangeError
 from clutchocp.optimal.clamp import ClampModel
 from clutchocp.optimal.feasibility import (
     FILM_FLOOR,
     holding_capacity,
     lockup_energy_bound,
+    own_profile_within_contact,
     temperature_bound,
     thermal_response,
     usable_pressure,
 )
-from clutchocp.engagement.edges import zero_gap_pressure
+from clutchocp.engagement.edges import check_contact_capacity, zero_gap_pressure
 from clutchocp.optimal.problem import EngagementOCP, solver_verdict
 from clutchocp.scene import default_scene, load_scene
 
@@ -201,6 +202,41 @@ def test_the_contact_caps_the_usable_pressure_and_the_films():
     least, hardest = clamp.pressure_range()
     assert hardest == pytest.approx(p) and clamp.settled_films(hardest)[0] == pytest.approx(FILM_FLOOR * film.sigma,
                                                                                               rel=1e-6)
+
+
+def test_a_profile_pressing_beyond_the_contact_is_held_within_it_for_the_baseline():
+    """sigma_1 = 6 um: the scene's own 0.8 MPa presses harder than the 0.77 MPa the contact carries at zero gap,
+    so its own run is refused; the optimiser's baseline is the same profile held at the usable pressure,
+    which the contact check passes. The default scene keeps its own profile."""
+    scene = default_scene().with_overrides({"roughness.sigma_1": 6e-6})
+    model = EngagementModel(scene, pressure_command=ca.SX.sym("u"))
+    with pytest.raises(PhysicalRangeError):
+        check_contact_capacity(scene)
+    held, note = own_profile_within_contact(scene, model, 1.5e6)
+    p = usable_pressure(model, 1.5e6)
+    assert held.value("actuation.pressure") == pytest.approx(p, rel=1e-12) and p < 0.8e6
+    assert held.value("actuation.initial_pressure") == scene.value("actuation.initial_pressure")
+    assert held.variant("actuation") == scene.variant("actuation")
+    capacity, pack = check_contact_capacity(held)
+    assert pack.pressure_Pa <= capacity.pressure_Pa
+    assert "\n" not in note and "0.8 MPa" in note and f"{p / 1e6:.4g} MPa" in note
+    plain = default_scene()
+    assert own_profile_within_contact(plain, EngagementModel(plain, pressure_command=ca.SX.sym("u")), 1.5e6) \
+        == (plain, None)
+
+
+def test_a_pressure_table_pressing_beyond_the_contact_is_refused_in_one_line(tmp_path):
+    """A table is the user's own profile: it is not changed for the baseline but refused, naming the capacity."""
+    table = tmp_path / "pressure.csv"
+    table.write_text("t_s,p_Pa\n0,0\n0.05,8e5\n", encoding="utf-8")
+    scene = default_scene().with_overrides({"roughness.sigma_1": 6e-6, "actuation.model": "table",
+                                            "actuation.file": str(table),
+                                            "actuation.time_constant": None})
+    model = EngagementModel(scene, pressure_command=ca.SX.sym("u"))
+    with pytest.raises(PhysicalRangeError) as info:
+        own_profile_within_contact(scene, model, 1.5e6)
+    message = str(info.value)
+    assert "\n" not in message and "contact capacity" in message and "0.771 MPa" in message
 
 
 def test_a_clamp_margin_the_pack_cannot_hold_names_the_largest():

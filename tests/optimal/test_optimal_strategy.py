@@ -47,3 +47,33 @@ def test_a_default_t_max_faster_than_any_jump_free_lock_is_raised():
     assert abs(opt.terms["lockup_torque_jump_Nm"]) < 0.01 * ocp.lock_torque
     with pytest.raises(ModelError, match=f"--t-max must be at least {t_star:.4g} s"):
         solve_robustly(ocp, t_max=ocp.default_t_max())
+
+
+class _LocallyInfeasibleWithTheAdaptiveBarrier:
+    """A problem whose adaptive barrier update ends at a local point of infeasibility and whose monotone one
+    converges from the same start (as bao2020_as_published's first solve on 60 slip intervals did)."""
+
+    def __init__(self):
+        self.calls = []
+
+    def default_t_max(self):
+        return 1.0
+
+    def default_t_max_source(self):
+        return "the lock-up time of the scene's own profile"
+
+    def solve(self, *, t_max, weights, guess, e_max=None, barrier="adaptive"):
+        self.calls.append(barrier)
+        if barrier == "adaptive":
+            error = SolverError("optimal engagement: no optimum found: a local point of infeasibility")
+            error.status = "Infeasible_Problem_Detected"
+            raise error
+        return type("Optimum", (), {"stats": {"status": "Solve_Succeeded", "iterations": 208, "wall_time_s": 1.0}})()
+
+
+def test_a_local_point_of_infeasibility_is_solved_again_with_the_monotone_barrier():
+    problem = _LocallyInfeasibleWithTheAdaptiveBarrier()
+    opt, t_max, info = solve_robustly(problem)
+    assert problem.calls == ["adaptive", "monotone"] and t_max == 1.0
+    assert opt.stats["status"] == "Solve_Succeeded" and info["barrier"] == "monotone"
+    assert [a["stage"] for a in info["attempts"]] == ["solve", "solve (monotone barrier)"]

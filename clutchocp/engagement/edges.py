@@ -177,7 +177,8 @@ def check_contact_capacity(scene, *, max_pressure=None):
     capacity = contact_capacity(scene)
     if capacity is None:
         return None
-    source = "actuation.max_pressure" if max_pressure is not None else "actuation.pressure"
+    source = ("actuation.max_pressure" if max_pressure is not None
+              else "the pressures of actuation.file" if scene.variant("actuation") == "table" else "actuation.pressure")
     oil = (0.0, float(max_pressure)) if max_pressure is not None else run_oil_pressures(scene)
     pack = pack_pressure(scene, oil)
     if pack.pressure_Pa <= capacity.pressure_Pa:

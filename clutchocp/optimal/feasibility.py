@@ -138,7 +138,7 @@ def own_profile_within_contact(scene, model, p_max):
     except PhysicalRangeError as err:
         refusal = err
     if scene.variant("actuation") == "table":
-        raise PhysicalRangeError(f"scene '{scene.name}': contact capacity: {refusal}") from None
+        raise PhysicalRangeError(f"scene '{scene.name}': {refusal}") from None
     usable = usable_pressure(model, p_max)
     pick = max if spring_applied(model) else min
     keys = ("actuation.pressure", "actuation.initial_pressure")
@@ -146,7 +146,7 @@ def own_profile_within_contact(scene, model, p_max):
     try:
         capacity, _ = check_contact_capacity(held)
     except PhysicalRangeError:
-        raise PhysicalRangeError(f"scene '{scene.name}': contact capacity: {refusal}") from None
+        raise PhysicalRangeError(f"scene '{scene.name}': {refusal}") from None
     side = "at least" if spring_applied(model) else "at most"
     note = (f"the scene's own profile (actuation.pressure {scene.value('actuation.pressure') / 1e6:.4g} MPa) presses "
             f"harder than the contact carries at zero gap ({capacity.pressure_Pa / 1e6:.4g} MPa); the baseline is "

@@ -236,7 +236,8 @@ def test_a_pressure_table_pressing_beyond_the_contact_is_refused_in_one_line(tmp
     with pytest.raises(PhysicalRangeError) as info:
         own_profile_within_contact(scene, model, 1.5e6)
     message = str(info.value)
-    assert "\n" not in message and "contact capacity" in message and "0.771 MPa" in message
+    assert "\n" not in message and "carries at most 0.771 MPa at zero gap" in message
+    assert "actuation.file" in message and message.count("contact:") == 1      # the table is the field to change
 
 
 def test_a_clamp_margin_the_pack_cannot_hold_names_the_largest():

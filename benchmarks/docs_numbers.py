@@ -482,6 +482,25 @@ def tcu_heldout(item):
     return {"command": "python benchmarks/bench_tcu_heldout.py --samples 20 --seed 5 --workers 2", **data}
 
 
+REFUSALS = (("optimize", "models/catalogue/infeasible_dct_overload_launch.toml"),
+            ("optimize", "default_driveline_thermal", "--max-temperature", "45"),
+            ("optimize", "--set", "plates.r_inner=75 mm", "--set", "plates.r_outer=98 mm", "--set",
+             "plates.n_interfaces=6", "--t-max", "0.05"))
+
+
+def optimize_refusals(item):
+    """Three clutches ``clutchocp optimize`` refuses before solving, and the line each prints."""
+    rows = []
+    for args in REFUSALS:
+        run = item.clutchocp(*(str(ROOT / a) if a.startswith("models/") else a for a in args), check=False)
+        line = next((x for x in run.stderr.splitlines() if x.startswith("clutchocp optimize: error:")), None)
+        if run.returncode != 2 or line is None:
+            raise RuntimeError(f"clutchocp {' '.join(args)}: expected a one-line refusal (exit 2), got exit "
+                               f"{run.returncode}: {run.stderr.strip()[-500:]}")
+        rows.append({"command": "clutchocp " + " ".join(f'"{a}"' if " " in a else a for a in args), "printed": line})
+    return {"rows": rows}
+
+
 def bench(item):
     """``clutchocp bench --quick``: IDAS against scipy's integrators at matched error."""
     run = item.clutchocp("bench", "--quick")
@@ -571,13 +590,14 @@ ITEMS = {
     "sweep": sweep,
     "optimize_scenes": optimize_scenes,
     "robust": robust,
+    "optimize_refusals": optimize_refusals,
     "tcu_acceptance": tcu_acceptance,
     "tcu_heldout": tcu_heldout,
     "bench": bench,
 }
 # Priority of an item's commands when two wait for a slot: the longest first, so that the two slots
 # finish together (robust ~35 %, bench and optimize_scenes ~25 % each of the commands' time).
-ORDER = ("robust", "optimize_scenes", "bench", "tcu_heldout", "tcu_acceptance", "optimize_weights", "sweep", "control", "optimize_default",
+ORDER = ("robust", "optimize_scenes", "bench", "tcu_heldout", "tcu_acceptance", "optimize_refusals", "optimize_weights", "sweep", "control", "optimize_default",
          "simulate_scenes", "physics", "cycles", "readme_example", "validate")
 KEYS_OF = {"optimize": ("optimize_default", "optimize_scenes"), "simulate": ("simulate_scenes",),
            "cycles": ("cycles",), "validate": ("validate",), "control": ("control",), "sweep": ("sweep",),
@@ -816,6 +836,12 @@ def r_tcu_heldout(n):
             + f"\n({d['samples']} draws per condition; `{d['command']}`; {measured(n, 'tcu_heldout')}.)\n")
 
 
+def r_optimize_refusals(n):
+    d = n["optimize_refusals"]
+    lines = "\n".join(f"$ {r['command']}\n{r['printed']}" for r in d["rows"])
+    return f"```text\n{lines}\n```\n({measured(n, 'optimize_refusals')}.)\n"
+
+
 def r_bench(n):
     s = n["bench"]["summary"]
     scenes = s.get("scenes") or {k: v for k, v in s.items() if isinstance(v, dict) and "speedup_vs_radau" in v}
@@ -981,6 +1007,7 @@ RENDERERS = {
     "optimize-scenes": r_optimize_scenes,
     "fill-comparison": r_fill_comparison,
     "robust": r_robust,
+    "optimize-refusals": r_optimize_refusals,
     "tcu-acceptance": r_tcu_acceptance,
     "tcu-heldout": r_tcu_heldout,
     "bench": r_bench,

@@ -11,7 +11,8 @@ Files (:func:`export_controller`, in the output folder of ``clutchocp robust``):
   integration length and the LQR gains on every state of the TCU and the slip-error integral, each
   column with its unit (the command in Pa per unit of the state);
 * ``calibration_estimator.csv``: per design and sample, every entry of the Kalman filter's tables (A, B,
-  C, M, y_ref, slip_row) in long form: matrix, row, column, value and its SI unit;
+  C, M, y_ref, slip_row) in long form: matrix, row, column, value and its SI unit; of the prediction's
+  bilinear term H the entries that are not zero, column ``d:<field>*<state or du>``;
 * ``controller.json``: all of it (state and reading names with units, the tables as nested lists);
 * ``tcu_step.c``, ``tcu_step.h``: the law of :func:`clutchocp.shiftcontrol.tcu.step_function`, generated
   by CasADi (``casadi.CodeGenerator``); its inputs are a sample's table rows, the readings and the TCU's
@@ -96,7 +97,7 @@ def export_controller(out, schedule):
              _gains_csv(out / "calibration_gain_schedule.csv", feedbacks, names),
              _estimator_csv(out / "calibration_estimator.csv", feedbacks, names, measured)]
     files.append(_json(out / "controller.json", schedule, field, values))
-    files += generate_c(out, len(names), len(measured))
+    files += generate_c(out, len(names), len(measured), first.parameters)
     return files
 
 
@@ -155,6 +156,12 @@ def _entries(f, names, measured):
             yield "y_ref", k, r, "", t["y_ref"][k, i], state_unit(r)
         for j, c in enumerate(names):
             yield "slip_row", k, "slip", c, t["slip_row"][k, j], _ratio("rad/s", state_unit(c))
+        factors = list(names) + ["du"]           # H acts on d (x) [xi; du]: the entries that are not zero
+        for i, r in enumerate(names):
+            for column in np.flatnonzero(t["H"][k, i]):
+                d, c = names[f.parameters[column // len(factors)]], factors[column % len(factors)]
+                unit = _ratio(state_unit(r), "Pa" if c == "du" else state_unit(c))
+                yield "H", k, r, f"{d}*{c}", t["H"][k, i, column], unit
 
 
 def _estimator_csv(path, feedbacks, names, measured):
@@ -190,11 +197,13 @@ def _json(path, schedule, field, values):
     return path
 
 
-def generate_c(out, n, p):
-    """``tcu_step.c`` and ``tcu_step.h``: the per-sample law for n states and p readings (CasADi code generation)."""
+def generate_c(out, n, p, parameters=()):
+    """``tcu_step.c`` and ``tcu_step.h``: the per-sample law for n states, p readings and the estimated parameters
+    at the state positions ``parameters`` (:attr:`~clutchocp.shiftcontrol.tcu.TCUFeedback.parameters`; CasADi
+    code generation)."""
     out = Path(out)
     generator = ca.CodeGenerator(f"{C_NAME}.c", {"with_header": True})
-    generator.add(step_function(n, p))
+    generator.add(step_function(n, p, tuple(parameters)))
     generator.generate(str(out) + "/")
     return [out / f"{C_NAME}.c", out / f"{C_NAME}.h"]
 
@@ -216,14 +225,15 @@ def compile_shared(folder, cc=None):
     return library
 
 
-def time_c_step(folder, inputs, repeats=200_000, cc=None):
+def time_c_step(folder, inputs, repeats=200_000, cc=None, parameters=()):
     """Seconds per call of the generated ``tcu_step`` on one sample's inputs (a dict by input name), measured by
-    a C loop compiled with -O2 beside it (the time of the law alone, without Python)."""
+    a C loop compiled with -O2 beside it (the time of the law alone, without Python); ``parameters`` as given to
+    :func:`generate_c`."""
     cc = cc or compiler()
     if cc is None:
         raise ModelError("no C compiler (cc, gcc, clang) on this machine")
     folder = Path(folder)
-    f = step_function(*_sizes(inputs))
+    f = step_function(*_sizes(inputs), tuple(parameters))
     arrays, pointers = [], []
     for i, name in enumerate(STEP_INPUTS):
         values = np.asarray(ca.DM(inputs[name]).full(), float).ravel(order="F")

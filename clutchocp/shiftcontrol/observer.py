@@ -64,6 +64,11 @@ class TCUModel:
         states ``d:``) and (x) the Kronecker product: column j (n + 1) + i is d(Psi_j)/d(v_i), the change of
         parameter j's column with the model state, previous or current correction v_i
         (:meth:`TCUModelBuilder.column_derivative`; zero for the other states).
+    G_sub : (N, n, S), u_sub : (N, S), held_sub : (N, S)
+        Per sample, the states at its end per Pa of correction over sub-interval s alone (zero-padded; the
+        columns of ``held_sub`` 1 sum to B_k, those of 0 to the previous correction's column of A_k), the
+        feedforward there [Pa] and which correction acts there (1: the current, 0: the previous): the command
+        clipped between samples, clip(u_ff + du) - u_ff, acts through them.
     C : (N, p, n)
         Readings' deviations from their nominal values: dy_k = C_k xi_k + noise.
     y_ref : (N, p)
@@ -99,6 +104,9 @@ class TCUModel:
     t_ref: np.ndarray
     rate_ref: np.ndarray
     H: np.ndarray
+    G_sub: np.ndarray
+    u_sub: np.ndarray
+    held_sub: np.ndarray
 
     def kalman(self):
         """Gains and covariances of the time-varying Kalman filter (:func:`clutchocp.control.kalman.tvkf`)."""
@@ -132,6 +140,17 @@ def sample_grid(sample_times, t_lock, sample_time, dead_time):
             times.append([t0, t1])
             times.append(midpoints(t0, t1, sample_time))
     return np.unique(np.concatenate(times))
+
+
+def _padded(subs, n_a):
+    """(G_sub (N, n_a, S), u_sub (N, S), held_sub (N, S)) from each sample's sub-interval columns, feedforward at
+    their midpoints and flags (:meth:`TCUModelBuilder.sub_interval_columns`), zero-padded to the most sub-intervals."""
+    S = max(columns.shape[1] for columns, _, _ in subs)
+    G, u, held = np.zeros((len(subs), n_a, S)), np.zeros((len(subs), S)), np.zeros((len(subs), S))
+    for k, (columns, values, flags) in enumerate(subs):
+        G[k, :columns.shape[0], :columns.shape[1]] = columns
+        u[k, :values.size], held[k, :flags.size] = values, flags
+    return G, u, held
 
 
 class TCUModelBuilder:
@@ -250,6 +269,26 @@ class TCUModelBuilder:
                 G_cur = G_cur + Gm
         return Phi, G_prev, G_cur, Psi
 
+    def sub_interval_columns(self, start, end, Ts):
+        """(columns (n_c, S), midpoints (S,), held (S,)) of the sample's sub-intervals: the dynamic states at the
+        sample's end per Pa of correction held over sub-interval s alone (frozen pieces, as :meth:`_part_map`: they
+        sum to Gamma_prev and Gamma_cur), its midpoint [s] and whether the current correction (1) or the previous
+        one (0) acts there. The TCU knows the command it clips between samples from them."""
+        n_c = self.n_c
+        columns, times, held_flags = [], [], []
+        for t0, t1, held in _pieces(start, end, self.dead_time):
+            mids = midpoints(t0, t1, Ts)
+            dt = (t1 - t0) / mids.size
+            M = np.zeros((n_c + 1, n_c + 1))
+            for t in mids:
+                A, B, _, _, _ = self._continuous(t)
+                M[:n_c, :n_c], M[:n_c, n_c:] = A * dt, B * dt
+                E = expm(M)
+                columns = [E[:n_c, :n_c] @ c for c in columns] + [E[:n_c, n_c]]
+                times.append(float(t))
+                held_flags.append(1.0 if held == "current" else 0.0)
+        return np.array(columns).T, np.array(times), np.array(held_flags)
+
     def responses_at_midpoints(self, start, end, Ts):
         """{t: S(t)} at every midpoint of the sample: the model states' response (n, n + 2) to a deviation of each
         model state at the sample's start, the previous correction and the current one [SI/Pa] (nominal flow,
@@ -315,6 +354,7 @@ class TCUModelBuilder:
         p = len(self.measured)
         A, B, C = np.zeros((N, n_a, n_a)), np.zeros((N, n_a)), np.zeros((N, p, n_a))
         H = np.zeros((N, n_a, self.m * (n_a + 1)))
+        subs = []
         slip, rate, y_ref = np.zeros((N, n_a)), np.zeros((N, n_a)), np.zeros((N, p))
         durations = np.minimum(np.asarray(sample_times) + Ts, t_lock) - np.asarray(sample_times)
         params = [self.index(f"d:{name}") for name in self.lin.parameter_names]
@@ -327,6 +367,8 @@ class TCUModelBuilder:
                 H[k][:n_c, at:at + self.n] = column[:, :self.n]
                 H[k][:n_c, at + self.index("du_prev")] = column[:, self.n]
                 H[k][:n_c, at + n_a] = column[:, self.n + 1]
+            columns, mids, held = self.sub_interval_columns(start, end, Ts)
+            subs.append((columns, np.array([self.trajectory(t)[2] for t in mids]), held))
             A[k] = np.eye(n_a)
             A[k][:n_c, :n_c] = Phi
             A[k][:n_c, params] = Psi
@@ -355,7 +397,7 @@ class TCUModelBuilder:
         times = np.array([self.reading_times(t, Ts)[0] for t in sample_times])
         rates = np.array([self.reading_times(t, Ts)[1] for t in sample_times])
         return TCUModel(self.names, self.measured, A, B, C, y_ref, slip, rate, slip_end, rate_end, durations, Q, R,
-                        self._prior(y_ref[0], Ts), times, rates, H)
+                        self._prior(y_ref[0], Ts), times, rates, H, *_padded(subs, n_a))
 
     def _readings(self, t, Ts):
         """(C rows, nominal readings) at time t."""

@@ -12,8 +12,7 @@ Files (:func:`export_controller`, in the output folder of ``clutchocp robust``):
   column with its unit (the command in Pa per unit of the state);
 * ``calibration_estimator.csv``: per design and sample, every entry of the Kalman filter's tables (A, B,
   C, M, y_ref, slip_row) in long form: matrix, row, column, value and its SI unit; of the prediction's
-  bilinear term H the entries that are not zero, column ``d:<field>*<state or du>``, and so of its
-  curvature Hxx, column ``<state>*<state>`` (model states, ``du_prev``, ``du``); per sub-interval
+  bilinear term H the entries that are not zero, column ``d:<field>*<state or du>``; per sub-interval
   ``sub<s>`` of a sample the correction's column G_sub, the feedforward u_sub and the flag held_sub (1: the
   current correction acts there, 0: the previous one) through which the command clipped between samples acts;
 * ``controller.json``: all of it (state and reading names with units, the tables as nested lists);
@@ -100,7 +99,7 @@ def export_controller(out, schedule):
              _gains_csv(out / "calibration_gain_schedule.csv", feedbacks, names),
              _estimator_csv(out / "calibration_estimator.csv", feedbacks, names, measured)]
     files.append(_json(out / "controller.json", schedule, field, values))
-    files += generate_c(out, len(names), len(measured), first.parameters, first.subs, first.states)
+    files += generate_c(out, len(names), len(measured), first.parameters, first.subs)
     return files
 
 
@@ -170,13 +169,6 @@ def _entries(f, names, measured):
                 d, c = names[f.parameters[column // len(factors)]], factors[column % len(factors)]
                 unit = _ratio(state_unit(r), "Pa" if c == "du" else state_unit(c))
                 yield "H", k, r, f"{d}*{c}", t["H"][k, i, column], unit
-        factors = list(names[:f.states]) + ["du_prev", "du"]     # Hxx acts on v (x) v: the entries not zero
-        for i, r in enumerate(names):
-            for column in np.flatnonzero(t["Hxx"][k, i]):
-                a, c = (factors[column // len(factors)], factors[column % len(factors)])
-                units = ["Pa" if x in ("du_prev", "du") else state_unit(x) for x in (a, c)]
-                unit = _ratio(state_unit(r), f"{units[0]} {units[1]}")
-                yield "Hxx", k, r, f"{a}*{c}", t["Hxx"][k, i, column], unit
 
 
 def _estimator_csv(path, feedbacks, names, measured):
@@ -212,13 +204,13 @@ def _json(path, schedule, field, values):
     return path
 
 
-def generate_c(out, n, p, parameters=(), subs=0, states=0):
+def generate_c(out, n, p, parameters=(), subs=0):
     """``tcu_step.c`` and ``tcu_step.h``: the per-sample law for n states, p readings, the estimated parameters
-    at the state positions ``parameters``, ``subs`` sub-intervals per sample and ``states`` model states
-    (:attr:`~clutchocp.shiftcontrol.tcu.TCUFeedback.parameters`, ``subs``, ``states``; CasADi code generation)."""
+    at the state positions ``parameters`` and ``subs`` sub-intervals per sample
+    (:attr:`~clutchocp.shiftcontrol.tcu.TCUFeedback.parameters`, ``subs``; CasADi code generation)."""
     out = Path(out)
     generator = ca.CodeGenerator(f"{C_NAME}.c", {"with_header": True})
-    generator.add(step_function(n, p, tuple(parameters), int(subs), int(states)))
+    generator.add(step_function(n, p, tuple(parameters), int(subs)))
     generator.generate(str(out) + "/")
     return [out / f"{C_NAME}.c", out / f"{C_NAME}.h"]
 
@@ -248,8 +240,7 @@ def time_c_step(folder, inputs, repeats=200_000, cc=None, parameters=()):
     if cc is None:
         raise ModelError("no C compiler (cc, gcc, clang) on this machine")
     folder = Path(folder)
-    f = step_function(*_sizes(inputs), tuple(parameters), int(np.size(inputs["u_sub"])),
-                      int(round(np.sqrt(np.size(inputs["Hxx"]) / np.size(inputs["x_prior"])))) - 2)
+    f = step_function(*_sizes(inputs), tuple(parameters), int(np.size(inputs["u_sub"])))
     arrays, pointers = [], []
     for i, name in enumerate(STEP_INPUTS):
         values = np.asarray(ca.DM(inputs[name]).full(), float).ravel(order="F")

@@ -127,7 +127,7 @@ def design_tcu_feedback(scene, command_times, command, spec, sensors, *, model=N
     engagement = model.engagement
     clamp = ClampModel(scene, model=engagement, command=engagement.hybrid.u["pressure_command"]) \
         .clamp_pressure(DEFAULT_MARGIN)
-    tables = {"A": tcu_model.A, "B": tcu_model.B, "H": tcu_model.H, "Hxx": tcu_model.Hxx, "G_sub": tcu_model.G_sub, "u_sub": tcu_model.u_sub,
+    tables = {"A": tcu_model.A, "B": tcu_model.B, "H": tcu_model.H, "G_sub": tcu_model.G_sub, "u_sub": tcu_model.u_sub,
               "held_sub": tcu_model.held_sub, "C": tcu_model.C, "M": M, "K": K,
               "y_ref": tcu_model.y_ref, "slip_row": tcu_model.slip_row, "dt": tcu_model.durations,
               "u_ff": np.interp(starts + D, times, values), "t_ref": tcu_model.t_ref, "rate_ref": tcu_model.rate_ref}

@@ -64,9 +64,6 @@ class TCUModel:
         states ``d:``) and (x) the Kronecker product: column j (n + 1) + i is d(Psi_j)/d(v_i), the change of
         parameter j's column with the model state, previous or current correction v_i
         (:meth:`TCUModelBuilder.column_derivative`; zero for the other states).
-    Hxx : (N, n, (n_x + 2)^2)
-        The curvature of the prediction: xi_k+1 += Hxx_k (v (x) v), v = [the n_x model states; du_prev; du_k]
-        (half the symmetrised second derivative of the sample map, :meth:`TCUModelBuilder.column_derivative`).
     G_sub : (N, n, S), u_sub : (N, S), held_sub : (N, S)
         Per sample, the states at its end per Pa of correction over sub-interval s alone (zero-padded; the
         columns of ``held_sub`` 1 sum to B_k, those of 0 to the previous correction's column of A_k), the
@@ -107,7 +104,6 @@ class TCUModel:
     t_ref: np.ndarray
     rate_ref: np.ndarray
     H: np.ndarray
-    Hxx: np.ndarray
     G_sub: np.ndarray
     u_sub: np.ndarray
     held_sub: np.ndarray
@@ -322,9 +318,7 @@ class TCUModelBuilder:
     def column_derivative(self, start, end, Ts):
         """H = d Psi / d v of the sample [start, end]: (n_c, m, n + 2), the change of each parameter's column Psi_j
         (its effect on the states at the sample's end) per deviation v of each model state at the sample's start,
-        of the previous correction and of the current one (the last two columns, per Pa); and the curvature of the
-        sample map T (n_c, n + 2, n + 2), T[:, a, i] = d(column a of [Phi (model states), Gamma_prev,
-        Gamma_cur]) / d v_i, symmetrised (a second derivative): x_k+1 = ... + T (v (x) v) / 2.
+        of the previous correction and of the current one (the last two columns, per Pa).
 
         The clutch met runs off the nominal trajectory, and there the parameters act with other columns (friction
         times a contact load that is not the nominal one): x_k+1 = ... + sum_j d_j H_j v is the bilinear term of
@@ -332,7 +326,7 @@ class TCUModelBuilder:
         carried by the nominal linear flow, :meth:`responses_at_midpoints`; for a correction the command moved
         too), eps = DIFFERENCE_STEP of the state's size (of the nominal valve pressure for the corrections)."""
         n, n_c = self.n, self.n_c
-        H, T = np.zeros((n_c, self.m, n + 2)), np.zeros((n_c, n + 2, n + 2))
+        H = np.zeros((n_c, self.m, n + 2))
         flow = self.responses_at_midpoints(start, end, Ts)
         x0 = self.trajectory(start)[0]
         rows = [self.lin.all_states.index(name) for name in self.lin.state_names]
@@ -350,11 +344,9 @@ class TCUModelBuilder:
                     moved[rows] = sign * eps * flow[float(t)][:, i]
                     return moved
                 corrections = tuple(sign * eps * (i == n + c) for c in (0, 1))
-                Phi, G_prev, G_cur, Psi = self.sample_map(start, end, Ts, shift, corrections)
-                columns.append(np.hstack([Psi, Phi[:, :n], G_prev, G_cur]))
-            change = (columns[0] - columns[1]) / (2 * eps)
-            H[:, :, i], T[:, :, i] = change[:, :self.m], change[:, self.m:]
-        return H, 0.5 * (T + T.transpose(0, 2, 1))
+                columns.append(self.sample_map(start, end, Ts, shift, corrections)[3])
+            H[:, :, i] = (columns[0] - columns[1]) / (2 * eps)
+        return H
 
     def build(self, sample_times, t_lock, Ts):
         """The :class:`TCUModel` over the samples t_0 .. t_N-1 (the last one ends at t_lock)."""
@@ -362,7 +354,6 @@ class TCUModelBuilder:
         p = len(self.measured)
         A, B, C = np.zeros((N, n_a, n_a)), np.zeros((N, n_a)), np.zeros((N, p, n_a))
         H = np.zeros((N, n_a, self.m * (n_a + 1)))
-        Hxx = np.zeros((N, n_a, (self.n + 2) ** 2))
         subs = []
         slip, rate, y_ref = np.zeros((N, n_a)), np.zeros((N, n_a)), np.zeros((N, p))
         durations = np.minimum(np.asarray(sample_times) + Ts, t_lock) - np.asarray(sample_times)
@@ -371,13 +362,11 @@ class TCUModelBuilder:
         for k, start in enumerate(sample_times):
             end = start + durations[k]
             Phi, G_prev, G_cur, Psi = self.sample_map(start, end, Ts)
-            bilinear, curvature = self.column_derivative(start, end, Ts)
-            for j, column in enumerate(bilinear.transpose(1, 0, 2)):
+            for j, column in enumerate(self.column_derivative(start, end, Ts).transpose(1, 0, 2)):
                 at = j * (n_a + 1)               # acts on d_j [xi; du]: the model states, du_prev and du
                 H[k][:n_c, at:at + self.n] = column[:, :self.n]
                 H[k][:n_c, at + self.index("du_prev")] = column[:, self.n]
                 H[k][:n_c, at + n_a] = column[:, self.n + 1]
-            Hxx[k][:n_c] = 0.5 * curvature.reshape(n_c, -1)      # acts on v (x) v, v = [model states; du_prev; du]
             columns, mids, held = self.sub_interval_columns(start, end, Ts)
             subs.append((columns, np.array([self.trajectory(t)[2] for t in mids]), held))
             A[k] = np.eye(n_a)
@@ -408,7 +397,7 @@ class TCUModelBuilder:
         times = np.array([self.reading_times(t, Ts)[0] for t in sample_times])
         rates = np.array([self.reading_times(t, Ts)[1] for t in sample_times])
         return TCUModel(self.names, self.measured, A, B, C, y_ref, slip, rate, slip_end, rate_end, durations, Q, R,
-                        self._prior(y_ref[0], Ts), times, rates, H, Hxx, *_padded(subs, n_a))
+                        self._prior(y_ref[0], Ts), times, rates, H, *_padded(subs, n_a))
 
     def _readings(self, t, Ts):
         """(C rows, nominal readings) at time t."""

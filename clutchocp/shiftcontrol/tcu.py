@@ -13,7 +13,6 @@ engine-torque signal) and, with the tables of its calibration for that sample:
     du      = u - u_ff,k
     z_k+1   = z_k + dt_k (slip row) xi_k    (not while limited in the direction it would push: clamping)
     xi_k+1^- = A_k xi_k + B_k du + H_k (d (x) [xi_k; du])      d = the estimated parameters in xi_k
-               + Hxx_k (v (x) v)                                      v = [model states in xi_k; du_prev; du]
                + sum_s G_s (clip(u_s + c_s, p_min, p_max) - u_s - c_s)   c_s = du, or du_prev in the dead time
 
 A tooth-wheel reading is the mean speed over its window, i.e. the speed at the window's middle, which
@@ -21,8 +20,7 @@ the TCU knows from its stamps (``y_time``); the model's reading stands for the n
 (``t_ref``): the difference times the nominal acceleration (``rate_ref``) moves it there. The
 prediction's bilinear term H_k (d (x) [xi_k; du]) (Kronecker product) is the change of the parameters' effect off the
 nominal trajectory (:attr:`~clutchocp.shiftcontrol.observer.TCUModel.H`): a clutch whose friction is off and
-whose films run thinner than the nominal ones feels its friction through another contact load; the
-curvature term Hxx_k the sample map's second order in the states (a contact load exponential in the film). The
+whose films run thinner than the nominal ones feels its friction through another contact load. The
 last sum is the command the TCU clipped between samples (sub-intervals s of the sample, feedforward u_s there,
 columns G_s of :attr:`~clutchocp.shiftcontrol.observer.TCUModel.G_sub`): zero while nothing clips.
 u_ff,k is the feedforward at t_k + D (D: the valve dead time the TCU assumes; it sends its command
@@ -42,7 +40,7 @@ import numpy as np
 from ..errors import ModelError
 
 STEP_INPUTS = ("y", "y_time", "y_ref", "t_ref", "rate_ref", "x_prior", "integral", "u_prev", "first", "lock_count",
-               "M", "C", "K", "A", "B", "H", "Hxx", "G_sub", "u_sub", "held_sub", "slip_row", "dt", "u_ff", "limits")
+               "M", "C", "K", "A", "B", "H", "G_sub", "u_sub", "held_sub", "slip_row", "dt", "u_ff", "limits")
 STEP_OUTPUTS = ("u", "du", "u_unsat", "x_post", "x_next", "integral_next", "lock_count_next")
 LIMITS = ("p_min", "p_max", "reach", "clamping", "lock_slip")
 
@@ -66,17 +64,16 @@ def clipped_command(times, values, p_min, p_max):
 
 
 @functools.lru_cache(maxsize=16)
-def step_function(n, p, parameters=(), subs=0, states=0):
+def step_function(n, p, parameters=(), subs=0):
     """The per-sample law as a CasADi function for a TCU state of ``n`` and ``p`` readings (see the module docstring).
 
     ``parameters``: the positions in the state of the m estimated parameters d (a tuple of int) the bilinear term
-    multiplies the state with; ``subs``: the sub-intervals S of a sample; ``states``: the model states n_x, the
-    first entries of the state, that the curvature term multiplies. The previous correction du_prev is the
+    multiplies the state with; ``subs``: the sub-intervals S of a sample. The previous correction du_prev is the
     state's last entry.
 
     Inputs (:data:`STEP_INPUTS`): y, y_time [s], y_ref, t_ref [s], rate_ref (p), x_prior (n), integral, u_prev,
     first (1 at the first sample: no previous command), lock_count, M (n x p), C (p x n), K (1 x n+1), A (n x n), B (n),
-    H (n x m (n + 1)), Hxx (n x (n_x + 2)^2), G_sub (n x S), u_sub (S) [Pa], held_sub (S), slip_row (1 x n),
+    H (n x m (n + 1)), G_sub (n x S), u_sub (S) [Pa], held_sub (S), slip_row (1 x n),
     dt [s], u_ff [Pa], limits (p_min [Pa], p_max [Pa], reach [Pa], clamping (0/1), lock_slip [rad/s]).
     Outputs (:data:`STEP_OUTPUTS`): u, du, u_unsat [Pa], x_post, x_next (n), integral_next, lock_count_next.
     """
@@ -86,7 +83,6 @@ def step_function(n, p, parameters=(), subs=0, states=0):
     integral, u_prev, first, lock_count = sx("integral"), sx("u_prev"), sx("first"), sx("lock_count")
     M, C, K, A, B = sx("M", n, p), sx("C", p, n), sx("K", 1, n + 1), sx("A", n, n), sx("B", n)
     H = sx("H", n, len(parameters) * (n + 1))
-    Hxx = sx("Hxx", n, (states + 2) ** 2)
     G_sub, u_sub, held_sub = sx("G_sub", n, subs), sx("u_sub", subs), sx("held_sub", subs)
     slip_row, dt, u_ff, limits = sx("slip_row", 1, n), sx("dt"), sx("u_ff"), sx("limits", len(LIMITS))
     p_min, p_max, reach, clamping, lock_slip = (limits[i] for i in range(len(LIMITS)))
@@ -107,13 +103,11 @@ def step_function(n, p, parameters=(), subs=0, states=0):
     bilinear = ca.vertcat(*[x_post[i] * ca.vertcat(x_post, du) for i in parameters]) if parameters else ca.SX(0, 1)
     held = held_sub * du + (1 - held_sub) * x_post[n - 1]      # the correction acting in each sub-interval
     clipped = ca.fmin(ca.fmax(u_sub + held, p_min), p_max) - u_sub - held
-    v = ca.vertcat(x_post[:states], x_post[n - 1], du)
-    x_next = (ca.mtimes(A, x_post) + B * du + ca.mtimes(H, bilinear) + ca.mtimes(Hxx, ca.vertcat(*[v[i] * v for i in
-              range(states + 2)])) + ca.mtimes(G_sub, clipped))
+    x_next = ca.mtimes(A, x_post) + B * du + ca.mtimes(H, bilinear) + ca.mtimes(G_sub, clipped)
     outputs = [u, du, u_unsat, x_post, x_next, integral + increment,
                ca.if_else(near, lock_count + 1, 0.0)]
     inputs = [y, y_time, y_ref, t_ref, rate_ref, x_prior, integral, u_prev, first, lock_count, M, C, K, A, B, H,
-              Hxx, G_sub, u_sub, held_sub, slip_row, dt, u_ff, limits]
+              G_sub, u_sub, held_sub, slip_row, dt, u_ff, limits]
     return ca.Function("tcu_step", inputs, outputs, list(STEP_INPUTS), list(STEP_OUTPUTS))
 
 
@@ -128,7 +122,7 @@ class TCUFeedback:
         The TCU's state and its readings (:class:`~clutchocp.shiftcontrol.observer.TCUModel`).
     tables : dict of arrays
         Per sample k = 0 .. N-1: ``A`` (N, n, n), ``B`` (N, n), ``H`` (N, n, m (n + 1)) the prediction's bilinear term
-        (m: the states ``d:``), ``Hxx`` (N, n, (n_x + 2)^2) its curvature (n_x model states), ``G_sub`` (N, n, S), ``u_sub`` (N, S) [Pa], ``held_sub`` (N, S) the command clipped
+        (m: the states ``d:``), ``G_sub`` (N, n, S), ``u_sub`` (N, S) [Pa], ``held_sub`` (N, S) the command clipped
         between samples (:class:`~clutchocp.shiftcontrol.observer.TCUModel`), ``C`` (N, p, n), ``M`` (N, n, p) Kalman gains,
         ``K`` (N, n + 1) LQR gains on [xi; z], ``y_ref`` (N, p), ``slip_row`` (N, n), ``dt`` (N,) [s],
         ``u_ff`` (N,) the feedforward at t_k + D [Pa], ``t_ref`` (N, p) the time each reading stands for
@@ -162,9 +156,7 @@ class TCUFeedback:
         if self.names[-1] != "du_prev":
             raise ModelError("TCUFeedback: the state's last entry must be du_prev")
         S = self.subs = self.tables["u_sub"].shape[-1] if "u_sub" in self.tables else 0
-        self.states = int(round(np.sqrt(self.tables["Hxx"].shape[-1]))) - 2 if "Hxx" in self.tables else 0
-        shapes = {"A": (N, n, n), "B": (N, n), "H": (N, n, len(self.parameters) * (n + 1)),
-                  "Hxx": (N, n, (self.states + 2) ** 2), "C": (N, p, n),
+        shapes = {"A": (N, n, n), "B": (N, n), "H": (N, n, len(self.parameters) * (n + 1)), "C": (N, p, n),
                   "G_sub": (N, n, S), "u_sub": (N, S), "held_sub": (N, S),
                   "M": (N, n, p), "K": (N, n + 1), "y_ref": (N, p), "slip_row": (N, n), "dt": (N,), "u_ff": (N,), "t_ref": (N, p), "rate_ref": (N, p)}
         for key, shape in shapes.items():
@@ -178,7 +170,7 @@ class TCUFeedback:
         self.anti_windup = anti_windup
         self.lock_slip, self.lock_samples = float(lock_slip), int(lock_samples)
         self.clamp_pressure, self.nominal_torque = float(clamp_pressure), float(nominal_torque)
-        self._step = step_function(n, p, self.parameters, S, self.states)
+        self._step = step_function(n, p, self.parameters, S)
         self.reset()
 
     @property
@@ -211,7 +203,7 @@ class TCUFeedback:
         """The table inputs of :func:`step_function` for sample k (a dict by input name)."""
         t = self.tables
         return {"M": t["M"][k], "C": t["C"][k], "K": t["K"][k][None, :], "A": t["A"][k], "B": t["B"][k], "H": t["H"][k],
-                "Hxx": t["Hxx"][k], "G_sub": t["G_sub"][k], "u_sub": t["u_sub"][k], "held_sub": t["held_sub"][k],
+                "G_sub": t["G_sub"][k], "u_sub": t["u_sub"][k], "held_sub": t["held_sub"][k],
                 "slip_row": t["slip_row"][k][None, :], "dt": t["dt"][k], "u_ff": t["u_ff"][k],
                 "y_ref": t["y_ref"][k], "t_ref": t["t_ref"][k], "rate_ref": t["rate_ref"][k], "limits": self.limits()}
 

@@ -146,7 +146,7 @@ def test_generated_c_matches_the_python_controller_to_round_off(designed, tmp_pa
     # 0.135 s: a 14-sample design, and this clutch runs 14 samples, measured)
     assert len(calls) >= feedback.horizon - feedback.lock_samples
     files = generate_c(tmp_path, len(feedback.names), len(feedback.measured), feedback.parameters,
-                       feedback.subs, feedback.states)
+                       feedback.subs)
     assert [f.name for f in files] == ["tcu_step.c", "tcu_step.h"]
     compiled = ca.external("tcu_step", str(compile_shared(tmp_path)))
     assert compiled.name_in() == list(STEP_INPUTS) and compiled.name_out() == list(STEP_OUTPUTS)

@@ -46,6 +46,7 @@ class TCUDesign:
     M: np.ndarray              # (N, n, p)
     P_prior: np.ndarray        # (N + 1, n, n)
     P_post: np.ndarray         # (N, n, n)
+    builder: TCUModelBuilder = None    # the model's builder (its sample maps along moved trajectories)
 
 
 def check_parameters(scene, names):
@@ -134,7 +135,7 @@ def design_tcu_feedback(scene, command_times, command, spec, sensors, *, model=N
     feedback = TCUFeedback(Ts, tcu_model.names, tcu_model.measured, tables, (times, values), D, p_lo, p_hi,
                            (p_hi - p_lo) / spec.rate_limit_time, spec.anti_windup, lock_slip, spec.lock["samples"],
                            clamp, scene.value("driveline.input_torque"))
-    return TCUDesign(feedback, nominal, t_lock, tcu_model, K, M, P_prior, P_post)
+    return TCUDesign(feedback, nominal, t_lock, tcu_model, K, M, P_prior, P_post, builder)
 
 
 def _pressure_reference(sensors, t, p):

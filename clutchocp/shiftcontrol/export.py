@@ -11,7 +11,10 @@ Files (:func:`export_controller`, in the output folder of ``clutchocp robust``):
   integration length and the LQR gains on every state of the TCU and the slip-error integral, each
   column with its unit (the command in Pa per unit of the state);
 * ``calibration_estimator.csv``: per design and sample, every entry of the Kalman filter's tables (A, B,
-  C, M, y_ref, slip_row) in long form: matrix, row, column, value and its SI unit;
+  C, M, y_ref, slip_row) in long form: matrix, row, column, value and its SI unit; of the prediction's
+  bilinear term H the entries that are not zero, column ``d:<field>*<state or du>``; per sub-interval
+  ``sub<s>`` of a sample the correction's column G_sub, the feedforward u_sub and the flag held_sub (1: the
+  current correction acts there, 0: the previous one) through which the command clipped between samples acts;
 * ``controller.json``: all of it (state and reading names with units, the tables as nested lists);
 * ``tcu_step.c``, ``tcu_step.h``: the law of :func:`clutchocp.shiftcontrol.tcu.step_function`, generated
   by CasADi (``casadi.CodeGenerator``); its inputs are a sample's table rows, the readings and the TCU's
@@ -96,7 +99,7 @@ def export_controller(out, schedule):
              _gains_csv(out / "calibration_gain_schedule.csv", feedbacks, names),
              _estimator_csv(out / "calibration_estimator.csv", feedbacks, names, measured)]
     files.append(_json(out / "controller.json", schedule, field, values))
-    files += generate_c(out, len(names), len(measured))
+    files += generate_c(out, len(names), len(measured), first.parameters, first.subs)
     return files
 
 
@@ -155,6 +158,17 @@ def _entries(f, names, measured):
             yield "y_ref", k, r, "", t["y_ref"][k, i], state_unit(r)
         for j, c in enumerate(names):
             yield "slip_row", k, "slip", c, t["slip_row"][k, j], _ratio("rad/s", state_unit(c))
+        for s in range(f.subs):
+            for i, r in enumerate(names):
+                yield "G_sub", k, r, f"sub{s}", t["G_sub"][k, i, s], _ratio(state_unit(r), "Pa")
+            yield "u_sub", k, f"sub{s}", "", t["u_sub"][k, s], "Pa"
+            yield "held_sub", k, f"sub{s}", "", t["held_sub"][k, s], "1"
+        factors = list(names) + ["du"]           # H acts on d (x) [xi; du]: the entries that are not zero
+        for i, r in enumerate(names):
+            for column in np.flatnonzero(t["H"][k, i]):
+                d, c = names[f.parameters[column // len(factors)]], factors[column % len(factors)]
+                unit = _ratio(state_unit(r), "Pa" if c == "du" else state_unit(c))
+                yield "H", k, r, f"{d}*{c}", t["H"][k, i, column], unit
 
 
 def _estimator_csv(path, feedbacks, names, measured):
@@ -190,11 +204,13 @@ def _json(path, schedule, field, values):
     return path
 
 
-def generate_c(out, n, p):
-    """``tcu_step.c`` and ``tcu_step.h``: the per-sample law for n states and p readings (CasADi code generation)."""
+def generate_c(out, n, p, parameters=(), subs=0):
+    """``tcu_step.c`` and ``tcu_step.h``: the per-sample law for n states, p readings, the estimated parameters
+    at the state positions ``parameters`` and ``subs`` sub-intervals per sample
+    (:attr:`~clutchocp.shiftcontrol.tcu.TCUFeedback.parameters`, ``subs``; CasADi code generation)."""
     out = Path(out)
     generator = ca.CodeGenerator(f"{C_NAME}.c", {"with_header": True})
-    generator.add(step_function(n, p))
+    generator.add(step_function(n, p, tuple(parameters), int(subs)))
     generator.generate(str(out) + "/")
     return [out / f"{C_NAME}.c", out / f"{C_NAME}.h"]
 
@@ -216,14 +232,15 @@ def compile_shared(folder, cc=None):
     return library
 
 
-def time_c_step(folder, inputs, repeats=200_000, cc=None):
+def time_c_step(folder, inputs, repeats=200_000, cc=None, parameters=()):
     """Seconds per call of the generated ``tcu_step`` on one sample's inputs (a dict by input name), measured by
-    a C loop compiled with -O2 beside it (the time of the law alone, without Python)."""
+    a C loop compiled with -O2 beside it (the time of the law alone, without Python); ``parameters`` as given to
+    :func:`generate_c`."""
     cc = cc or compiler()
     if cc is None:
         raise ModelError("no C compiler (cc, gcc, clang) on this machine")
     folder = Path(folder)
-    f = step_function(*_sizes(inputs))
+    f = step_function(*_sizes(inputs), tuple(parameters), int(np.size(inputs["u_sub"])))
     arrays, pointers = [], []
     for i, name in enumerate(STEP_INPUTS):
         values = np.asarray(ca.DM(inputs[name]).full(), float).ravel(order="F")

@@ -78,7 +78,7 @@ class SlipLinearization:
             raise ModelError("slip linearisation: the slip mode depends on time explicitly (a pressure profile, "
                              "not a command)")
         parameters = dict(parameters or {})
-        self.parameter_names = tuple(parameters)
+        self.parameter_names = self._symbols = tuple(parameters)
         p = ca.vertcat(*[symbol for symbol, _ in parameters.values()]) if parameters else ca.SX(0, 1)
         self._p0 = np.array([value for _, value in parameters.values()], float)
         self._jacobians = jacobian_function("slip_jacobians", [x_all, z, u, p], x, z, u, f, g, c)
@@ -138,10 +138,16 @@ class SlipLinearization:
         (_, F), (_, G) = eliminate_algebraic(gx, gz, g_p, (fx, fz, f_p), (cx, cz, c_p))
         return F, G
 
-    def values(self, x, u, z=None):
-        """(f, g, c) at a point: state rates (n,), algebraic residuals, signals (numpy arrays)."""
+    def values(self, x, u, z=None, relative=None):
+        """(f, g, c) at a point: state rates (n,), algebraic residuals, signals (numpy arrays); ``relative``, optional:
+        {field: d} relative changes of parameters the model takes as symbols, theta = theta_nom (1 + d)."""
         x, z = self._point(x, z)
-        return [np.array(v, float).ravel() for v in self._values(x, z, u, self._p0)]
+        p = self._p0.copy()
+        for name, change in (relative or {}).items():
+            if name not in self._symbols:
+                raise ModelError(f"slip linearisation: {name} is not a symbol of the model ({', '.join(self._symbols)})")
+            p[self._symbols.index(name)] *= 1.0 + change
+        return [np.array(v, float).ravel() for v in self._values(x, z, u, p)]
 
     def sample_map(self, points, u_points, dt, z_points=None):
         """(Phi, Gamma) of one sample from the trajectory at the midpoints of its m sub-intervals.

@@ -46,6 +46,7 @@ class TCUDesign:
     M: np.ndarray              # (N, n, p)
     P_prior: np.ndarray        # (N + 1, n, n)
     P_post: np.ndarray         # (N, n, n)
+    builder: TCUModelBuilder = None    # the model's builder (its sample maps along moved trajectories)
 
 
 def check_parameters(scene, names):
@@ -127,13 +128,14 @@ def design_tcu_feedback(scene, command_times, command, spec, sensors, *, model=N
     engagement = model.engagement
     clamp = ClampModel(scene, model=engagement, command=engagement.hybrid.u["pressure_command"]) \
         .clamp_pressure(DEFAULT_MARGIN)
-    tables = {"A": tcu_model.A, "B": tcu_model.B, "C": tcu_model.C, "M": M, "K": K, "y_ref": tcu_model.y_ref,
-              "slip_row": tcu_model.slip_row, "dt": tcu_model.durations,
+    tables = {"A": tcu_model.A, "B": tcu_model.B, "H": tcu_model.H, "G_sub": tcu_model.G_sub, "u_sub": tcu_model.u_sub,
+              "held_sub": tcu_model.held_sub, "C": tcu_model.C, "M": M, "K": K,
+              "y_ref": tcu_model.y_ref, "slip_row": tcu_model.slip_row, "dt": tcu_model.durations,
               "u_ff": np.interp(starts + D, times, values), "t_ref": tcu_model.t_ref, "rate_ref": tcu_model.rate_ref}
     feedback = TCUFeedback(Ts, tcu_model.names, tcu_model.measured, tables, (times, values), D, p_lo, p_hi,
                            (p_hi - p_lo) / spec.rate_limit_time, spec.anti_windup, lock_slip, spec.lock["samples"],
                            clamp, scene.value("driveline.input_torque"))
-    return TCUDesign(feedback, nominal, t_lock, tcu_model, K, M, P_prior, P_post)
+    return TCUDesign(feedback, nominal, t_lock, tcu_model, K, M, P_prior, P_post, builder)
 
 
 def _pressure_reference(sensors, t, p):

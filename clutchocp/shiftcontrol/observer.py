@@ -41,6 +41,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from ..control.kalman import tvkf
+from .linearize import DIFFERENCE_STEP
 
 SUBSTEPS = 8            # sub-intervals per sample (per part of a sample split at the dead time)
 ACCELERATION_SPREAD = 0.2   # a clutch's shaft acceleration may differ from the nominal by this fraction
@@ -57,7 +58,17 @@ class TCUModel:
     measured : tuple of str
         The readings: ``w_in``, ``w_out`` [rad/s], ``p_sensor`` [Pa], ``engine_torque`` [N m].
     A : (N, n, n), B : (N, n)
-        xi_k+1 = A_k xi_k + B_k du_k.
+        xi_k+1 = A_k xi_k + B_k du_k (+ the bilinear term of H).
+    H : (N, n, m (n + 1))
+        The bilinear term of the prediction: xi_k+1 += H_k (d (x) [xi_k; du_k]), d the m estimated parameters (the
+        states ``d:``) and (x) the Kronecker product: column j (n + 1) + i is d(Psi_j)/d(v_i), the change of
+        parameter j's column with the model state, previous or current correction v_i
+        (:meth:`TCUModelBuilder.column_derivative`; zero for the other states).
+    G_sub : (N, n, S), u_sub : (N, S), held_sub : (N, S)
+        Per sample, the states at its end per Pa of correction over sub-interval s alone (zero-padded; the
+        columns of ``held_sub`` 1 sum to B_k, those of 0 to the previous correction's column of A_k), the
+        feedforward there [Pa] and which correction acts there (1: the current, 0: the previous): the command
+        clipped between samples, clip(u_ff + du) - u_ff, acts through them.
     C : (N, p, n)
         Readings' deviations from their nominal values: dy_k = C_k xi_k + noise.
     y_ref : (N, p)
@@ -92,6 +103,10 @@ class TCUModel:
     P0: np.ndarray
     t_ref: np.ndarray
     rate_ref: np.ndarray
+    H: np.ndarray
+    G_sub: np.ndarray
+    u_sub: np.ndarray
+    held_sub: np.ndarray
 
     def kalman(self):
         """Gains and covariances of the time-varying Kalman filter (:func:`clutchocp.control.kalman.tvkf`)."""
@@ -125,6 +140,17 @@ def sample_grid(sample_times, t_lock, sample_time, dead_time):
             times.append([t0, t1])
             times.append(midpoints(t0, t1, sample_time))
     return np.unique(np.concatenate(times))
+
+
+def _padded(subs, n_a):
+    """(G_sub (N, n_a, S), u_sub (N, S), held_sub (N, S)) from each sample's sub-interval columns, feedforward at
+    their midpoints and flags (:meth:`TCUModelBuilder.sub_interval_columns`), zero-padded to the most sub-intervals."""
+    S = max(columns.shape[1] for columns, _, _ in subs)
+    G, u, held = np.zeros((len(subs), n_a, S)), np.zeros((len(subs), S)), np.zeros((len(subs), S))
+    for k, (columns, values, flags) in enumerate(subs):
+        G[k, :columns.shape[0], :columns.shape[1]] = columns
+        u[k, :values.size], held[k, :flags.size] = values, flags
+    return G, u, held
 
 
 class TCUModelBuilder:
@@ -184,9 +210,15 @@ class TCUModelBuilder:
     def index(self, name):
         return self.names.index(name)
 
-    def _continuous(self, t):
-        """(A_c, B_c, F_c, C signals (over the model's states), G) at time t: the model with the sensor lag."""
+    def _continuous(self, t, shift=None, correction=0.0):
+        """(A_c, B_c, F_c, C signals (over the model's states), G) at time t: the model with the sensor lag.
+
+        ``shift(t)``, optional: a deviation of all the model's states from the nominal trajectory (SI), and
+        ``correction`` one of the command [Pa], at which to linearise instead."""
         x, z, u = self.trajectory(t)
+        if shift is not None:
+            x = x + shift(t)
+        u = u + correction
         A, B, C, _ = self.lin.continuous(x, u, z)
         F, G = self.lin.parameter_columns(x, u, z)
         n, extra = self.n, self.n_c - self.n
@@ -204,41 +236,139 @@ class TCUModelBuilder:
             row += 1
         return A, B, F, C, G
 
-    def _part_map(self, t0, t1, Ts):
-        """(Phi, Gamma, Psi) of the dynamic states over [t0, t1] with a constant correction and parameters."""
+    def _part_map(self, t0, t1, Ts, shift=None, correction=0.0):
+        """(Phi, Gamma, Psi) of the dynamic states over [t0, t1] with a constant correction and parameters
+        (along the nominal trajectory, or the one moved by ``shift``, see :meth:`_continuous`)."""
         mids = midpoints(t0, t1, Ts)
         dt = (t1 - t0) / mids.size
         n_c = self.n_c
         Phi, Gamma, Psi = np.eye(n_c), np.zeros((n_c, 1)), np.zeros((n_c, self.m))
         M = np.zeros((n_c + 1 + self.m, n_c + 1 + self.m))
         for t in mids:
-            A, B, F, _, _ = self._continuous(t)
+            A, B, F, _, _ = self._continuous(t, shift, correction)
             M[:n_c, :n_c], M[:n_c, n_c:n_c + 1], M[:n_c, n_c + 1:] = A * dt, B * dt, F * dt
             E = expm(M)
             step = E[:n_c, :n_c]
             Phi, Gamma, Psi = step @ Phi, step @ Gamma + E[:n_c, n_c:n_c + 1], step @ Psi + E[:n_c, n_c + 1:]
         return Phi, Gamma, Psi
 
+    def sample_map(self, start, end, Ts, shift=None, corrections=(0.0, 0.0)):
+        """(Phi, Gamma_prev, Gamma_cur, Psi) of the dynamic states over the sample [start, end]: the pieces split at
+        the dead time composed (Gamma_prev: the previous correction's column, Gamma_cur: the current one's);
+        linearised along the trajectory moved by ``shift`` and ``corrections`` (previous, current) [Pa], see
+        :meth:`_continuous`."""
+        n_c = self.n_c
+        Phi, G_prev, G_cur, Psi = np.eye(n_c), np.zeros((n_c, 1)), np.zeros((n_c, 1)), np.zeros((n_c, self.m))
+        for t0, t1, held in _pieces(start, end, self.dead_time):
+            P_, Gm, Ps = self._part_map(t0, t1, Ts, shift, corrections[0 if held == "previous" else 1])
+            Phi, Psi = P_ @ Phi, P_ @ Psi + Ps
+            G_prev, G_cur = P_ @ G_prev, P_ @ G_cur
+            if held == "previous":
+                G_prev = G_prev + Gm
+            else:
+                G_cur = G_cur + Gm
+        return Phi, G_prev, G_cur, Psi
+
+    def sub_interval_columns(self, start, end, Ts):
+        """(columns (n_c, S), midpoints (S,), held (S,)) of the sample's sub-intervals: the dynamic states at the
+        sample's end per Pa of correction held over sub-interval s alone (frozen pieces, as :meth:`_part_map`: they
+        sum to Gamma_prev and Gamma_cur), its midpoint [s] and whether the current correction (1) or the previous
+        one (0) acts there. The TCU knows the command it clips between samples from them."""
+        n_c = self.n_c
+        columns, times, held_flags = [], [], []
+        for t0, t1, held in _pieces(start, end, self.dead_time):
+            mids = midpoints(t0, t1, Ts)
+            dt = (t1 - t0) / mids.size
+            M = np.zeros((n_c + 1, n_c + 1))
+            for t in mids:
+                A, B, _, _, _ = self._continuous(t)
+                M[:n_c, :n_c], M[:n_c, n_c:] = A * dt, B * dt
+                E = expm(M)
+                columns = [E[:n_c, :n_c] @ c for c in columns] + [E[:n_c, n_c]]
+                times.append(float(t))
+                held_flags.append(1.0 if held == "current" else 0.0)
+        return np.array(columns).T, np.array(times), np.array(held_flags)
+
+    def responses_at_midpoints(self, start, end, Ts):
+        """{t: S(t)} at every midpoint of the sample: the model states' response (n, n + 2) to a deviation of each
+        model state at the sample's start, the previous correction and the current one [SI/Pa] (nominal flow,
+        frozen pieces as :meth:`_part_map`)."""
+        n = self.n
+        S, out = np.hstack([np.eye(n), np.zeros((n, 2))]), {}
+        M = np.zeros((n + 1, n + 1))
+        for t0, t1, held in _pieces(start, end, self.dead_time):
+            mids = midpoints(t0, t1, Ts)
+            dt = (t1 - t0) / mids.size
+            column = n if held == "previous" else n + 1
+            for t in mids:
+                A, B = self.lin.continuous(*self._point(t))[:2]
+                M[:n, :n], M[:n, n:] = A * 0.5 * dt, B * 0.5 * dt
+                half = expm(M)
+                S = half[:n, :n] @ S
+                S[:, column] += half[:n, n]
+                out[float(t)] = S.copy()
+                S = half[:n, :n] @ S
+                S[:, column] += half[:n, n]
+        return out
+
+    def _point(self, t):
+        x, z, u = self.trajectory(t)
+        return x, u, z
+
+    def column_derivative(self, start, end, Ts):
+        """H = d Psi / d v of the sample [start, end]: (n_c, m, n + 2), the change of each parameter's column Psi_j
+        (its effect on the states at the sample's end) per deviation v of each model state at the sample's start,
+        of the previous correction and of the current one (the last two columns, per Pa).
+
+        The clutch met runs off the nominal trajectory, and there the parameters act with other columns (friction
+        times a contact load that is not the nominal one): x_k+1 = ... + sum_j d_j H_j v is the bilinear term of
+        the sample map. Central differences of Psi along the trajectory moved by +-eps S(t) e_i (the deviation e_i
+        carried by the nominal linear flow, :meth:`responses_at_midpoints`; for a correction the command moved
+        too), eps = DIFFERENCE_STEP of the state's size (of the nominal valve pressure for the corrections)."""
+        n, n_c = self.n, self.n_c
+        H = np.zeros((n_c, self.m, n + 2))
+        flow = self.responses_at_midpoints(start, end, Ts)
+        x0 = self.trajectory(start)[0]
+        rows = [self.lin.all_states.index(name) for name in self.lin.state_names]
+        pressure = self.lin.nominal[self.lin.state_names.index("p_valve")] if "p_valve" in self.lin.state_names \
+            else 1.0
+        for i in range(n + 2):
+            if i < n:
+                eps = DIFFERENCE_STEP * max(abs(x0[rows[i]]), DIFFERENCE_STEP * abs(self.lin.nominal[i]))
+            else:
+                eps = DIFFERENCE_STEP * abs(pressure)
+            columns = []
+            for sign in (1.0, -1.0):
+                def shift(t, sign=sign):
+                    moved = np.zeros(x0.size)
+                    moved[rows] = sign * eps * flow[float(t)][:, i]
+                    return moved
+                corrections = tuple(sign * eps * (i == n + c) for c in (0, 1))
+                columns.append(self.sample_map(start, end, Ts, shift, corrections)[3])
+            H[:, :, i] = (columns[0] - columns[1]) / (2 * eps)
+        return H
+
     def build(self, sample_times, t_lock, Ts):
         """The :class:`TCUModel` over the samples t_0 .. t_N-1 (the last one ends at t_lock)."""
         N, n_a, n_c = len(sample_times), len(self.names), self.n_c
         p = len(self.measured)
         A, B, C = np.zeros((N, n_a, n_a)), np.zeros((N, n_a)), np.zeros((N, p, n_a))
+        H = np.zeros((N, n_a, self.m * (n_a + 1)))
+        subs = []
         slip, rate, y_ref = np.zeros((N, n_a)), np.zeros((N, n_a)), np.zeros((N, p))
         durations = np.minimum(np.asarray(sample_times) + Ts, t_lock) - np.asarray(sample_times)
         params = [self.index(f"d:{name}") for name in self.lin.parameter_names]
         sig = {name: j for j, name in enumerate(self.lin.signals)}
         for k, start in enumerate(sample_times):
             end = start + durations[k]
-            Phi, G_prev, G_cur, Psi = np.eye(n_c), np.zeros((n_c, 1)), np.zeros((n_c, 1)), np.zeros((n_c, self.m))
-            for t0, t1, held in _pieces(start, end, self.dead_time):
-                P_, Gm, Ps = self._part_map(t0, t1, Ts)
-                Phi, Psi = P_ @ Phi, P_ @ Psi + Ps
-                G_prev, G_cur = P_ @ G_prev, P_ @ G_cur
-                if held == "previous":
-                    G_prev = G_prev + Gm
-                else:
-                    G_cur = G_cur + Gm
+            Phi, G_prev, G_cur, Psi = self.sample_map(start, end, Ts)
+            for j, column in enumerate(self.column_derivative(start, end, Ts).transpose(1, 0, 2)):
+                at = j * (n_a + 1)               # acts on d_j [xi; du]: the model states, du_prev and du
+                H[k][:n_c, at:at + self.n] = column[:, :self.n]
+                H[k][:n_c, at + self.index("du_prev")] = column[:, self.n]
+                H[k][:n_c, at + n_a] = column[:, self.n + 1]
+            columns, mids, held = self.sub_interval_columns(start, end, Ts)
+            subs.append((columns, np.array([self.trajectory(t)[2] for t in mids]), held))
             A[k] = np.eye(n_a)
             A[k][:n_c, :n_c] = Phi
             A[k][:n_c, params] = Psi
@@ -267,7 +397,7 @@ class TCUModelBuilder:
         times = np.array([self.reading_times(t, Ts)[0] for t in sample_times])
         rates = np.array([self.reading_times(t, Ts)[1] for t in sample_times])
         return TCUModel(self.names, self.measured, A, B, C, y_ref, slip, rate, slip_end, rate_end, durations, Q, R,
-                        self._prior(y_ref[0], Ts), times, rates)
+                        self._prior(y_ref[0], Ts), times, rates, H, *_padded(subs, n_a))
 
     def _readings(self, t, Ts):
         """(C rows, nominal readings) at time t."""

@@ -12,11 +12,17 @@ engine-torque signal) and, with the tables of its calibration for that sample:
     u       = max(u, u_prev) while |w_in - w_out| (measured) <= lock_slip   (lock-up hold)
     du      = u - u_ff,k
     z_k+1   = z_k + dt_k (slip row) xi_k    (not while limited in the direction it would push: clamping)
-    xi_k+1^- = A_k xi_k + B_k du
+    xi_k+1^- = A_k xi_k + B_k du + H_k (d (x) [xi_k; du])      d = the estimated parameters in xi_k
+               + sum_s G_s (clip(u_s + c_s, p_min, p_max) - u_s - c_s)   c_s = du, or du_prev in the dead time
 
 A tooth-wheel reading is the mean speed over its window, i.e. the speed at the window's middle, which
 the TCU knows from its stamps (``y_time``); the model's reading stands for the nominal middle
-(``t_ref``): the difference times the nominal acceleration (``rate_ref``) moves it there.
+(``t_ref``): the difference times the nominal acceleration (``rate_ref``) moves it there. The
+prediction's bilinear term H_k (d (x) [xi_k; du]) (Kronecker product) is the change of the parameters' effect off the
+nominal trajectory (:attr:`~clutchocp.shiftcontrol.observer.TCUModel.H`): a clutch whose friction is off and
+whose films run thinner than the nominal ones feels its friction through another contact load. The
+last sum is the command the TCU clipped between samples (sub-intervals s of the sample, feedforward u_s there,
+columns G_s of :attr:`~clutchocp.shiftcontrol.observer.TCUModel.G_sub`): zero while nothing clips.
 u_ff,k is the feedforward at t_k + D (D: the valve dead time the TCU assumes; it sends its command
 that much early); between samples the TCU's output is clip(u_ff(t + D) + du_k, p_min, p_max) (the valve
 cannot leave its range, :func:`clipped_command`). The lock-up counter counts
@@ -34,7 +40,7 @@ import numpy as np
 from ..errors import ModelError
 
 STEP_INPUTS = ("y", "y_time", "y_ref", "t_ref", "rate_ref", "x_prior", "integral", "u_prev", "first", "lock_count",
-               "M", "C", "K", "A", "B", "slip_row", "dt", "u_ff", "limits")
+               "M", "C", "K", "A", "B", "H", "G_sub", "u_sub", "held_sub", "slip_row", "dt", "u_ff", "limits")
 STEP_OUTPUTS = ("u", "du", "u_unsat", "x_post", "x_next", "integral_next", "lock_count_next")
 LIMITS = ("p_min", "p_max", "reach", "clamping", "lock_slip")
 
@@ -58,11 +64,16 @@ def clipped_command(times, values, p_min, p_max):
 
 
 @functools.lru_cache(maxsize=16)
-def step_function(n, p):
+def step_function(n, p, parameters=(), subs=0):
     """The per-sample law as a CasADi function for a TCU state of ``n`` and ``p`` readings (see the module docstring).
 
+    ``parameters``: the positions in the state of the m estimated parameters d (a tuple of int) the bilinear term
+    multiplies the state with; ``subs``: the sub-intervals S of a sample. The previous correction du_prev is the
+    state's last entry.
+
     Inputs (:data:`STEP_INPUTS`): y, y_time [s], y_ref, t_ref [s], rate_ref (p), x_prior (n), integral, u_prev,
-    first (1 at the first sample: no previous command), lock_count, M (n x p), C (p x n), K (1 x n+1), A (n x n), B (n), slip_row (1 x n),
+    first (1 at the first sample: no previous command), lock_count, M (n x p), C (p x n), K (1 x n+1), A (n x n), B (n),
+    H (n x m (n + 1)), G_sub (n x S), u_sub (S) [Pa], held_sub (S), slip_row (1 x n),
     dt [s], u_ff [Pa], limits (p_min [Pa], p_max [Pa], reach [Pa], clamping (0/1), lock_slip [rad/s]).
     Outputs (:data:`STEP_OUTPUTS`): u, du, u_unsat [Pa], x_post, x_next (n), integral_next, lock_count_next.
     """
@@ -71,6 +82,8 @@ def step_function(n, p):
     t_ref, rate_ref = sx("t_ref", p), sx("rate_ref", p)
     integral, u_prev, first, lock_count = sx("integral"), sx("u_prev"), sx("first"), sx("lock_count")
     M, C, K, A, B = sx("M", n, p), sx("C", p, n), sx("K", 1, n + 1), sx("A", n, n), sx("B", n)
+    H = sx("H", n, len(parameters) * (n + 1))
+    G_sub, u_sub, held_sub = sx("G_sub", n, subs), sx("u_sub", subs), sx("held_sub", subs)
     slip_row, dt, u_ff, limits = sx("slip_row", 1, n), sx("dt"), sx("u_ff"), sx("limits", len(LIMITS))
     p_min, p_max, reach, clamping, lock_slip = (limits[i] for i in range(len(LIMITS)))
 
@@ -87,10 +100,14 @@ def step_function(n, p):
     limited = ca.fabs(u - u_unsat) > 1e-9 * ca.fmax(ca.fabs(u_unsat), 1.0)
     pushes = (-k_xi * increment) * (u_unsat - u) > 0          # integrating would push further into the limit
     increment = ca.if_else(ca.logic_and(ca.logic_and(clamping, limited), pushes), 0.0, increment)
-    outputs = [u, du, u_unsat, x_post, ca.mtimes(A, x_post) + B * du, integral + increment,
+    bilinear = ca.vertcat(*[x_post[i] * ca.vertcat(x_post, du) for i in parameters]) if parameters else ca.SX(0, 1)
+    held = held_sub * du + (1 - held_sub) * x_post[n - 1]      # the correction acting in each sub-interval
+    clipped = ca.fmin(ca.fmax(u_sub + held, p_min), p_max) - u_sub - held
+    x_next = ca.mtimes(A, x_post) + B * du + ca.mtimes(H, bilinear) + ca.mtimes(G_sub, clipped)
+    outputs = [u, du, u_unsat, x_post, x_next, integral + increment,
                ca.if_else(near, lock_count + 1, 0.0)]
-    inputs = [y, y_time, y_ref, t_ref, rate_ref, x_prior, integral, u_prev, first, lock_count, M, C, K, A, B,
-              slip_row, dt, u_ff, limits]
+    inputs = [y, y_time, y_ref, t_ref, rate_ref, x_prior, integral, u_prev, first, lock_count, M, C, K, A, B, H,
+              G_sub, u_sub, held_sub, slip_row, dt, u_ff, limits]
     return ca.Function("tcu_step", inputs, outputs, list(STEP_INPUTS), list(STEP_OUTPUTS))
 
 
@@ -104,7 +121,9 @@ class TCUFeedback:
     names, measured : tuple of str
         The TCU's state and its readings (:class:`~clutchocp.shiftcontrol.observer.TCUModel`).
     tables : dict of arrays
-        Per sample k = 0 .. N-1: ``A`` (N, n, n), ``B`` (N, n), ``C`` (N, p, n), ``M`` (N, n, p) Kalman gains,
+        Per sample k = 0 .. N-1: ``A`` (N, n, n), ``B`` (N, n), ``H`` (N, n, m (n + 1)) the prediction's bilinear term
+        (m: the states ``d:``), ``G_sub`` (N, n, S), ``u_sub`` (N, S) [Pa], ``held_sub`` (N, S) the command clipped
+        between samples (:class:`~clutchocp.shiftcontrol.observer.TCUModel`), ``C`` (N, p, n), ``M`` (N, n, p) Kalman gains,
         ``K`` (N, n + 1) LQR gains on [xi; z], ``y_ref`` (N, p), ``slip_row`` (N, n), ``dt`` (N,) [s],
         ``u_ff`` (N,) the feedforward at t_k + D [Pa], ``t_ref`` (N, p) the time each reading stands for
         on the nominal trajectory [s], ``rate_ref`` (N, p) the nominal rate of each reading there.
@@ -133,8 +152,13 @@ class TCUFeedback:
         self.names, self.measured = tuple(names), tuple(measured)
         self.tables = {key: np.asarray(value, float) for key, value in tables.items()}
         N, n, p = self.tables["A"].shape[0], len(self.names), len(self.measured)
-        shapes = {"A": (N, n, n), "B": (N, n), "C": (N, p, n), "M": (N, n, p), "K": (N, n + 1), "y_ref": (N, p),
-                  "slip_row": (N, n), "dt": (N,), "u_ff": (N,), "t_ref": (N, p), "rate_ref": (N, p)}
+        self.parameters = tuple(i for i, name in enumerate(self.names) if name.startswith("d:"))
+        if self.names[-1] != "du_prev":
+            raise ModelError("TCUFeedback: the state's last entry must be du_prev")
+        S = self.subs = self.tables["u_sub"].shape[-1] if "u_sub" in self.tables else 0
+        shapes = {"A": (N, n, n), "B": (N, n), "H": (N, n, len(self.parameters) * (n + 1)), "C": (N, p, n),
+                  "G_sub": (N, n, S), "u_sub": (N, S), "held_sub": (N, S),
+                  "M": (N, n, p), "K": (N, n + 1), "y_ref": (N, p), "slip_row": (N, n), "dt": (N,), "u_ff": (N,), "t_ref": (N, p), "rate_ref": (N, p)}
         for key, shape in shapes.items():
             if self.tables.get(key) is None or self.tables[key].shape != shape:
                 raise ModelError(f"TCUFeedback: table {key} must be {shape}")
@@ -146,7 +170,7 @@ class TCUFeedback:
         self.anti_windup = anti_windup
         self.lock_slip, self.lock_samples = float(lock_slip), int(lock_samples)
         self.clamp_pressure, self.nominal_torque = float(clamp_pressure), float(nominal_torque)
-        self._step = step_function(n, p)
+        self._step = step_function(n, p, self.parameters, S)
         self.reset()
 
     @property
@@ -178,7 +202,8 @@ class TCUFeedback:
     def row(self, k):
         """The table inputs of :func:`step_function` for sample k (a dict by input name)."""
         t = self.tables
-        return {"M": t["M"][k], "C": t["C"][k], "K": t["K"][k][None, :], "A": t["A"][k], "B": t["B"][k],
+        return {"M": t["M"][k], "C": t["C"][k], "K": t["K"][k][None, :], "A": t["A"][k], "B": t["B"][k], "H": t["H"][k],
+                "G_sub": t["G_sub"][k], "u_sub": t["u_sub"][k], "held_sub": t["held_sub"][k],
                 "slip_row": t["slip_row"][k][None, :], "dt": t["dt"][k], "u_ff": t["u_ff"][k],
                 "y_ref": t["y_ref"][k], "t_ref": t["t_ref"][k], "rate_ref": t["rate_ref"][k], "limits": self.limits()}
 

@@ -7,6 +7,7 @@ from dataclasses import replace
 import casadi as ca
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 
 from clutchocp.optimal.problem import EngagementOCP
 from clutchocp.optimal.verify import run_numbers
@@ -101,6 +102,49 @@ def test_estimates_of_a_clutch_met_and_the_filter_consistency(designed):
     assert np.all(rms > 0.2) and np.all(rms < 2.0), rms
 
 
+def _one_sample(design, start, end, x0, relative):
+    """The nonlinear slip model (its state rates, no linearisation) integrated over [start, end] from the model
+    states x0 with the nominal feedforward and parameters changed by ``relative`` (Radau, tight tolerances)."""
+    builder = design.builder
+    lin = builder.lin
+    rows = [lin.all_states.index(name) for name in lin.state_names]
+
+    def rates(t, x):
+        states, _, u = builder.trajectory(t)
+        states = np.array(states)
+        states[rows] = x
+        return lin.values(states, u, None, relative)[0]
+
+    return solve_ivp(rates, (start, end), x0, method="Radau", rtol=1e-11,
+                     atol=1e-12 * np.abs(lin.nominal)).y[:, -1]
+
+
+def test_bilinear_term_is_the_nonlinear_models_mixed_second_difference(designed):
+    """H_k of a late sample (thin films, where the test clutch's friction column is 1.3-1.4 x the nominal one)
+    against the mixed second difference of the nonlinear model integrated over the sample (no linearisation, no
+    matrix exponential): friction +-1 % and a state deviation +-v (films 0.1 um thinner, 20 kPa more pressure)."""
+    _, _, spec, _, design = designed
+    builder, Ts = design.builder, spec.sample_time
+    lin, n = builder.lin, builder.n
+    k = design.feedback.horizon - 3
+    start, end = k * Ts, min((k + 1) * Ts, design.t_lock)
+    rows = [lin.all_states.index(name) for name in lin.state_names]
+    x0 = np.array(builder.trajectory(start)[0])[rows]
+    H = builder.column_derivative(start, end, Ts)
+    films = [i for i, name in enumerate(lin.state_names) if name.startswith("h_")]
+    v = np.zeros(n)
+    v[films], v[lin.state_names.index("p_valve")] = -1e-7, 2e4
+    h = 0.01
+    ends = {(a, c): _one_sample(design, start, end, x0 + a * v, {"friction.mu": c * h}) for a in (1, -1) for c in (1, -1)}
+    mixed = (ends[1, 1] - ends[1, -1] - ends[-1, 1] + ends[-1, -1]) / (4 * h)
+    j = lin.parameter_names.index("friction.mu")
+    speeds = [lin.state_names.index(name) for name in ("w_in", "w_out")]
+    assert (H[:n, j, :n] @ v)[speeds] == pytest.approx(mixed[speeds], rel=0.02)
+    assert np.all(np.abs(mixed[speeds]) > 0.005)      # the term is there [rad/s per unit friction change]
+    p = lin.state_names.index("p_valve")              # the valve does not feel the friction (to the integration's
+    assert (H[:n, j, :n] @ v)[p] == 0.0 and abs(mixed[p]) < 1e-2      # round-off of a 1 MPa pressure)
+
+
 def test_terminal_tolerances_weigh_slip_and_rate_at_lock_up_on_their_own(designed):
     """The terminal slip and slip-rate tolerances equal to the running ones are the terminal weight 1 (same
     gains); a tighter slip-rate tolerance at lock-up alone raises the gains of the last sample on the rate's
@@ -145,7 +189,8 @@ def test_generated_c_matches_the_python_controller_to_round_off(designed, tmp_pa
     # every sample of the run to the lock-up the TCU confirms (on the merged physics the nominal optimum locks at
     # 0.135 s: a 14-sample design, and this clutch runs 14 samples, measured)
     assert len(calls) >= feedback.horizon - feedback.lock_samples
-    files = generate_c(tmp_path, len(feedback.names), len(feedback.measured))
+    files = generate_c(tmp_path, len(feedback.names), len(feedback.measured), feedback.parameters,
+                       feedback.subs)
     assert [f.name for f in files] == ["tcu_step.c", "tcu_step.h"]
     compiled = ca.external("tcu_step", str(compile_shared(tmp_path)))
     assert compiled.name_in() == list(STEP_INPUTS) and compiled.name_out() == list(STEP_OUTPUTS)
@@ -157,7 +202,7 @@ def test_generated_c_matches_the_python_controller_to_round_off(designed, tmp_pa
             scale = np.maximum(np.abs(expected[key]), 1.0)
             worst = max(worst, float(np.max(np.abs(value - expected[key]) / scale)))
     assert worst <= 1e-12
-    seconds = time_c_step(tmp_path, calls[10][0], repeats=20_000)
+    seconds = time_c_step(tmp_path, calls[10][0], repeats=20_000, parameters=feedback.parameters)
     print(f"generated C: {seconds * 1e6:.2f} us per step ({len(feedback.names)} states, "
           f"{len(feedback.measured)} readings)")
     assert 0 < seconds < 1e-3

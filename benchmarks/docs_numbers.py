@@ -1219,13 +1219,24 @@ def undocumented(keys, page):
     return missing
 
 
+# A file one command writes with the columns of another's, documented on that command's page
+SHARED_FILES = {"optimize": {"timeseries.csv": "simulate"}}
+
+
 def undocumented_all(numbers):
     """{command: [what its page does not document]} over every item's recorded keys."""
     out = {}
     for command, items in KEYS_OF.items():
         keys = [numbers[i]["keys"] for i in items if i in numbers and "keys" in numbers[i]]
         if keys:
-            missing = undocumented(merge_keys(*keys), COMMAND_PAGES / f"{command}.md")
+            keys = merge_keys(*keys)
+            missing = []
+            for name, page in SHARED_FILES.get(command, {}).items():
+                if name in keys["csv"]:
+                    shared = {"summary": [], "csv": {name: keys["csv"][name]}, "files": []}
+                    missing += undocumented(shared, COMMAND_PAGES / f"{page}.md")
+                    keys = {**keys, "csv": {k: v for k, v in keys["csv"].items() if k != name}}
+            missing += undocumented(keys, COMMAND_PAGES / f"{command}.md")
             if missing:
                 out[command] = missing
     return out

@@ -102,6 +102,13 @@ def test_docs_the_key_check_reports_what_a_page_lacks(tmp_path):
     assert dn.undocumented(keys, page) == ["a.e.d", "empty[].*", "t.csv: y_3_m", "file other.png"]
 
 
+def test_docs_optimize_timeseries_columns_are_checked_on_the_simulate_page():
+    """optimize writes its IDAS replay with simulate's columns: they are looked up on simulate's page."""
+    keys = {"summary": [["scene"]], "csv": {"timeseries.csv": ["h_1", "no_such_column_xyz"]}, "files": []}
+    missing = dn.undocumented_all({"optimize_default": {"keys": keys}})
+    assert missing == {"optimize": ["timeseries.csv: no_such_column_xyz"]}
+
+
 def test_docs_a_placeholder_alone_documents_only_scene_field_columns(tmp_path):
     page = tmp_path / "page.md"
     page.write_text("film number `<i>`; one column per swept field: `<field>`\n")

@@ -479,7 +479,8 @@ def tcu_heldout(item):
             "run_name='__main__')")
     run = item.python(code, "tcu_heldout")
     data = json.loads((run.folder / "heldout.json").read_text())
-    return {"command": "python benchmarks/bench_tcu_heldout.py --samples 20 --seed 5 --workers 2", **data}
+    return {"command": "python benchmarks/bench_tcu_heldout.py --samples 20 --seed 5 --workers 2",
+            "conditions": list(data["results"]), **data}
 
 
 REFUSALS = (("optimize", "models/catalogue/infeasible_dct_overload_launch.toml"),
@@ -830,7 +831,8 @@ def r_tcu_heldout(n):
             return ["-", "- (exact readings only)"]
         return [pct(s["within_t_max"]), " / ".join(fmt(s[k], 3) for k in ("jump_median_pct", "jump_p95_pct",
                                                                           "jump_worst_pct"))]
-    rows = [(label, *cells(r.get("old")), *cells(r.get("tcu"))) for label, r in d["results"].items()]
+    order = d.get("conditions") or list(d["results"])          # the script's order (the JSON sorts keys)
+    rows = [(label, *cells(d["results"][label].get("old")), *cells(d["results"][label].get("tcu"))) for label in order]
     return (table(("condition", "old loop: within t_max", "old: \\|jump\\| % median / p95 / worst",
                    "TCU loop: within t_max", "TCU: \\|jump\\| % median / p95 / worst"), rows)
             + f"\n({d['samples']} draws per condition; `{d['command']}`; {measured(n, 'tcu_heldout')}.)\n")

@@ -52,6 +52,38 @@ class SlipFeedbackDesign:
     adaptation_off: str | None = None  # why the spec's adaptation cannot run on this scene (None: it runs or is off)
 
 
+
+def feedforward_lock(scene, times, values, Ts, model):
+    """The nominal lock-up of a feedforward and the TCU's samples before it.
+
+    Parameters
+    ----------
+    scene : clutchocp.scene.Scene
+    times, values : array
+        The feedforward [s], [Pa] (piecewise linear, last value held).
+    Ts : float
+        TCU sample time [s].
+    model : CommandModel
+
+    Returns
+    -------
+    (float, float, array)
+        The replay horizon [s] (1.5 x the feedforward's length + 2 samples), the lock-up time [s] and the
+        sample starts before it [s].
+
+    Raises
+    ------
+    ModelError
+        The feedforward does not lock up on the nominal scene within the horizon.
+    """
+    horizon = 1.5 * max(times[-1], Ts) + 2 * Ts
+    coarse = simulate_command(scene, times, values, horizon, model=model, control="linear", points=201)
+    t_lock = coarse.summary["engagement_time_s"]
+    if t_lock is None or not coarse.result.events:
+        raise ModelError(f"slip feedback: the feedforward does not lock up on the nominal scene '{scene.name}' "
+                         f"within {horizon:.3g} s; it cannot be a reference")
+    return horizon, t_lock, np.arange(int(np.ceil(t_lock / Ts - 1e-9))) * Ts
+
 def pressure_limits(scene, spec):
     """Command limits [Pa]: 0 .. actuation.max_pressure, narrowed by the spec."""
     p_max = scene.get("actuation.max_pressure")
@@ -105,14 +137,8 @@ def design_slip_feedback(scene, command_times, command, spec, *, model=None):
     Ts = spec.sample_time
     times, values = np.asarray(command_times, float), np.asarray(command, float)
     p_lo, p_hi = pressure_limits(scene, spec)
-    horizon = 1.5 * max(times[-1], Ts) + 2 * Ts
-    coarse = simulate_command(scene, times, values, horizon, model=model, control="linear", points=201)
-    t_lock = coarse.summary["engagement_time_s"]
-    if t_lock is None or not coarse.result.events:
-        raise ModelError(f"slip feedback: the feedforward does not lock up on the nominal scene '{scene.name}' "
-                         f"within {horizon:.3g} s; it cannot be a reference")
-    N = int(np.ceil(t_lock / Ts - 1e-9))
-    starts = np.arange(N) * Ts
+    horizon, t_lock, starts = feedforward_lock(scene, times, values, Ts, model)
+    N = len(starts)
     ends = np.minimum(starts + Ts, t_lock)
     mids = starts[:, None] + (ends - starts)[:, None] * (np.arange(SUBSTEPS) + 0.5) / SUBSTEPS
     grid = np.concatenate([starts, mids.ravel(), [t_lock]])

@@ -25,7 +25,7 @@ from ..engagement.run import EngagementResult
 from ..errors import ModelError
 from ..optimal.clamp import DEFAULT_MARGIN, ClampModel
 from ..optimal.replay import CommandModel, simulate_command
-from .design import _slip_trajectory, pressure_limits
+from .design import _slip_trajectory, feedforward_lock, pressure_limits
 from .linearize import parametric_linearization
 from .observer import TCUModel, TCUModelBuilder, sample_grid
 from .sensors import first_order_lag
@@ -89,14 +89,7 @@ def design_tcu_feedback(scene, command_times, command, spec, sensors, *, model=N
     Ts = spec.sample_time
     times, values = np.asarray(command_times, float), np.asarray(command, float)
     p_lo, p_hi = pressure_limits(scene, spec)
-    horizon = 1.5 * max(times[-1], Ts) + 2 * Ts
-    coarse = simulate_command(scene, times, values, horizon, model=model, control="linear", points=201)
-    t_lock = coarse.summary["engagement_time_s"]
-    if t_lock is None or not coarse.result.events:
-        raise ModelError(f"slip feedback: the feedforward does not lock up on the nominal scene '{scene.name}' "
-                         f"within {horizon:.3g} s; it cannot be a reference")
-    N = int(np.ceil(t_lock / Ts - 1e-9))
-    starts = np.arange(N) * Ts
+    horizon, t_lock, starts = feedforward_lock(scene, times, values, Ts, model)
     D = sensors.valve.assumed_dead_time
     grid = sample_grid(starts, t_lock, Ts, D)
     nominal = simulate_command(scene, times, values, min(horizon, t_lock + 2 * Ts), model=model, control="linear",

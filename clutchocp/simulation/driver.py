@@ -133,44 +133,47 @@ def _inputs(model, p, u, grid):
     return _Inputs(fixed, schedules, breaks)
 
 
-def _equal_input_runs(blocks):
-    """Indices of the consecutive ``blocks`` with the same inputs (``b[3]``): a list of lists."""
-    runs = []
-    for i, b in enumerate(blocks):
-        if runs and np.array_equal(blocks[runs[-1][0]][3], b[3]):
-            runs[-1].append(i)
-        else:
-            runs.append([i])
-    return runs
+def _outputs_on(evaluate, xs, zs, blocks_pu, t):
+    """Outputs (``evaluate``: a mode's ColumnFunction) on all samples of a segment, one call per run
+    of equal inputs."""
+    y = np.zeros((evaluate.n_out, t.size))
+    start = 0
+    for pu, count in blocks_pu:
+        if count:
+            y[:, start:start + count] = evaluate(xs[:, start:start + count], zs[:, start:start + count], pu,
+                                                 t[start:start + count])
+        start += count
+    return y
 
 
-def _outputs_on(evaluate, n_out, blocks):
-    """Outputs (``evaluate``: a mode's ColumnFunction) on all samples of a segment: (n_out, n).
+def _outputs_completed(evaluate, n_out, blocks):
+    """Outputs on all samples of a segment whose grid blocks carry them already (evaluated with the
+    events, :meth:`~clutchocp.simulation.compiled.CompiledMode.events_outputs`).
 
-    Each run of equal inputs is one call of ``evaluate`` on its samples, except that a block
-    whose outputs were evaluated already (with the events,
-    :meth:`~clutchocp.simulation.compiled.CompiledMode.events_outputs`) keeps them if the engine
-    that evaluated them (:meth:`~clutchocp.simulation.compiled.ColumnFunction.engine`) is the one
-    ``evaluate`` takes for its run: the same operations on the same numbers, bit for bit. The other
-    blocks of the run (single samples at events and input breaks, short grid blocks) are evaluated
-    together with that engine.
+    Every sample gets the value the segment's outputs ``evaluate`` would give it in one call on all
+    of them: a block keeps its outputs only if they were evaluated with the engine
+    (:meth:`~clutchocp.simulation.compiled.ColumnFunction.engine`) ``evaluate`` takes for the
+    whole segment (the same operations on the same numbers, bit for bit); the other blocks (single
+    samples at events and input breaks, short grid blocks) are evaluated by ``evaluate`` with that
+    engine, in one call per run of equal inputs.
     """
-    parts = [None] * len(blocks)
-    for run in _equal_input_runs(blocks):
-        engine = evaluate.engine(sum(blocks[i][0].size for i in run))
-        missing = []
-        for i in run:
-            if blocks[i][4] is not None and blocks[i][5] == engine:
-                parts[i] = blocks[i][4]
+    engine = evaluate.engine(sum(b[0].size for b in blocks))
+    parts, missing = [], []
+    for b in blocks:
+        if b[4] is None or b[5] != engine:
+            if missing and np.array_equal(missing[-1][0], b[3]):
+                missing[-1][1].append(len(parts))
             else:
-                missing.append(i)
-        if not missing:
-            continue
-        group = [blocks[i] for i in missing]
-        y = evaluate(np.concatenate([b[1] for b in group], axis=1), np.concatenate([b[2] for b in group], axis=1),
-                     group[0][3], np.concatenate([b[0] for b in group]), engine=engine)
+                missing.append([b[3], [len(parts)]])
+            parts.append(None)
+        else:
+            parts.append(b[4])
+    for pu, idx in missing:
+        group = [blocks[i] for i in idx]
+        y = evaluate(np.concatenate([b[1] for b in group], axis=1), np.concatenate([b[2] for b in group], axis=1), pu,
+                     np.concatenate([b[0] for b in group]), engine=engine)
         start = 0
-        for i in missing:
+        for i in idx:
             size = blocks[i][0].size
             parts[i] = y[:, start:start + size]
             start += size
@@ -209,7 +212,16 @@ class _Run:
             t = np.concatenate([b[0] for b in blocks]) if blocks else np.zeros(0)
             xs = np.concatenate([b[1] for b in blocks], axis=1) if blocks else np.zeros((cm.nx, 0))
             zs = np.concatenate([b[2] for b in blocks], axis=1) if blocks else np.zeros((cm.nz, 0))
-            y = _outputs_on(self._outputs_function(cm), len(cm.output_names), blocks)
+            if any(b[4] is not None for b in blocks):
+                y = _outputs_completed(self._outputs_function(cm), len(cm.output_names), blocks)
+            else:
+                runs = []
+                for b in blocks:                      # consecutive blocks with the same inputs share one call
+                    if runs and np.array_equal(runs[-1][0], b[3]):
+                        runs[-1][1] += b[0].size
+                    else:
+                        runs.append([b[3], b[0].size])
+                y = _outputs_on(self._outputs_function(cm), xs, zs, runs, t)
             out.append(Segment(cm.name, t,
                                {k: xs[j] * cm.x_nominal[j] for j, k in enumerate(cm.x_names)},
                                {k: zs[j] * cm.z_nominal[j] for j, k in enumerate(cm.z_names)},

@@ -378,35 +378,3 @@ def test_events_and_outputs_on_the_virtual_machine_path_equal_the_separate_funct
         if name != "mode":
             assert np.array_equal(a[name], b[name], equal_nan=True), name
     assert runs["vm"].summary["events"] == separate.summary["events"]
-
-
-def test_outputs_of_a_segment_are_one_call_per_run_of_equal_inputs_whatever_was_evaluated_before():
-    """The outputs of a segment's samples are those of one call per run of equal inputs: a block
-    evaluated before keeps its outputs only if the engine that evaluated them is the one its run
-    takes (a marker shows it was kept), else it is evaluated again with the rest of its run."""
-    import casadi as ca
-
-    from clutchocp.simulation import vectorized
-    from clutchocp.simulation.compiled import ColumnFunction
-    from clutchocp.simulation.driver import _outputs_on
-
-    xs, zs, pu, t = ca.SX.sym("xs", 2), ca.SX.sym("zs", 0), ca.SX.sym("pu", 1), ca.SX.sym("t")
-    f = ca.Function("f", [xs, zs, pu, t], [ca.vertcat(ca.exp(xs[0]) * pu - ca.log(1 + xs[1] ** 2), t * xs[1])])
-    column = ColumnFunction(f)
-    rng = np.random.default_rng(5)
-    big = vectorized.MIN_SAMPLES_PLAIN + 10
-
-    def block(n, p, y=None, engine=None):
-        return (np.sort(rng.uniform(size=n)), rng.normal(size=(2, n)), np.zeros((0, n)), np.array([p]), y, engine)
-
-    marker = np.full((2, big - 1), 7.0)
-    blocks = [block(1, 1.0), block(big - 1, 1.0, marker, "numpy"),           # run 1: numpy, the marker kept
-              block(1, 2.0), block(3, 2.0, np.full((2, 3), 7.0), "numpy")]    # run 2 (4 samples): casadi, redone
-    y = _outputs_on(column, 2, blocks)
-    assert column.engine(big) == "numpy" and column.engine(4) == "casadi"
-    assert np.array_equal(y[:, 1:big], marker)
-    run1 = column(np.concatenate([blocks[0][1], blocks[1][1]], axis=1), np.zeros((0, big)), [1.0],
-                  np.concatenate([blocks[0][0], blocks[1][0]]))
-    run2 = column(np.concatenate([blocks[2][1], blocks[3][1]], axis=1), np.zeros((0, 4)), [2.0],
-                  np.concatenate([blocks[2][0], blocks[3][0]]))
-    assert np.array_equal(y[:, :1], run1[:, :1]) and np.array_equal(y[:, big:], run2)

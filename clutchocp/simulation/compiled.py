@@ -101,38 +101,21 @@ class ColumnFunction:
             self._maps.pop(next(iter(self._maps)))
         return entry
 
-    def engine(self, n):
-        """What evaluates ``n`` samples: ``"loop"`` (the compiled loop), ``"numpy"`` (the numpy
-        translation, from :data:`~clutchocp.simulation.vectorized.MIN_SAMPLES` samples, or
-        ``MIN_SAMPLES_PLAIN`` without calls of unregistered functions) or ``"casadi"`` (CasADi's
-        virtual machine). Numpy and CasADi agree to within an ulp or two, each engine with itself
-        bit for bit whatever the samples evaluated together."""
-        if self._loop is not None:
-            return "loop"
-        if n >= (MIN_SAMPLES if self._calls else vectorized.MIN_SAMPLES_PLAIN) and self._numpy is not None:
-            return "numpy"
-        return "casadi"
-
-    def __call__(self, xs, zs, pu, t, engine=None):
-        """Outputs on the samples: array (n_out, n) for ``t`` of length n, evaluated by ``engine``
-        (default: :meth:`engine` of n; give one to match values evaluated on other samples)."""
+    def __call__(self, xs, zs, pu, t):
+        """Outputs on the samples: array (n_out, n) for ``t`` of length n."""
         t = np.atleast_1d(np.asarray(t, float)).ravel()
         n = t.size
         nx, nz = self.sizes[:2]
-        if n == 0:
-            return np.zeros((self.n_out, 0))
-        engine = engine or self.engine(n)
-        if engine == "loop":
+        if self._loop is not None and n:
             return self._looped(xs, zs, pu, t, n)
-        if engine == "numpy":
-            # contiguous rows: numpy's transcendental functions take other loops on strided rows (the
-            # states of an integrator call are a transposed view), and round differently there
+        if n >= (MIN_SAMPLES if self._calls else vectorized.MIN_SAMPLES_PLAIN) and self._numpy is not None:
             out = np.empty((self.n_out, n))
             with np.errstate(all="ignore"):       # as CasADi: NaN/inf where the expression gives them
-                self._numpy([np.ascontiguousarray(np.reshape(np.asarray(xs, float), (nx, n))),
-                             np.ascontiguousarray(np.reshape(np.asarray(zs, float), (nz, n))),
+                self._numpy([np.reshape(np.asarray(xs, float), (nx, n)), np.reshape(np.asarray(zs, float), (nz, n)),
                              np.ravel(np.asarray(pu, float)), t[None, :]], [out])
             return out
+        if n == 0:
+            return np.zeros((self.n_out, 0))
         if n == 1:
             return self._single(xs, zs, pu, t)
         m = padded_size(n)                         # a few cached maps serve every sample count
@@ -245,7 +228,6 @@ class CompiledMode:
         self._native_outputs_on = None
         self._native_events_on = None
         self._native_events_outputs = None
-        self._events_outputs = None
         self._on_samples = {}
         self.integrators = {}       # cached casadi integrators of this mode (see idas_path)
 
@@ -313,56 +295,34 @@ class CompiledMode:
         if not native:
             return self.events_on
         if self._native_events_on is None:
-            compiled = compile_columns(self.f_events) if self._events_call_tables() else None
+            f = self.f_events
+            calls = any(f.instruction_id(k) == ca.OP_CALL for k in range(f.n_instructions()))
+            compiled = None
+            if calls:
+                compiled = compile_columns(f)
             self._native_events_on = ColumnFunction(compiled[0], loop=compiled[1]) if compiled is not None \
                 else self.events_on
         return self._native_events_on
 
-    def _events_call_tables(self):
-        """Whether the scaled event functions call tables (interpolants): a locked mode's static
-        capacity against the torque to hold, which repeats much of its outputs."""
-        f = self.f_events
-        return any(f.instruction_id(k) == ca.OP_CALL for k in range(f.n_instructions()))
-
-    def _events_outputs_function(self):
-        """CasADi Function ``(xs, zs, pu, t) -> [scaled events; outputs]``, shared subexpressions once."""
-        args = [self.xs, self.zs, self.pu, self.t]
-        return ca.Function(f"{self.name}_events_outputs", args,
-                           [ca.densify(ca.cse(ca.vertcat(self.f_events(*args), self.f_outputs(*args))))])
-
-    def events_outputs(self, native=False):
-        """Column function of the scaled event functions followed by the outputs as one function
-        (shared subexpressions evaluated once), or None where the run evaluates them apart.
-
-        Only for a mode whose event functions call tables (:meth:`_events_call_tables`): a locked
-        mode's events repeat much of its outputs (default_driveline_thermal, locked: 299 and 965
-        instructions, 974 together; on its 1 757 grid samples 1.5 ms against 2.1 ms for the two,
-        measured). Elsewhere the events are a few instructions and a merged function would only
-        evaluate the outputs of the samples past a crossing for nothing. Each value is bit for bit
-        that of the separate functions (tested): ``native`` compiled code
-        (:meth:`native_events_outputs`) performs the same operations on the same numbers as the
-        compiled :meth:`event_values` and :meth:`native_outputs_on`, and so does the numpy
-        translation or CasADi's virtual machine as :attr:`events_on` and :attr:`outputs_on`.
-        """
-        if native:
-            return self.native_events_outputs()
-        if self._events_outputs is None:
-            merged = self.events and self._events_call_tables()
-            self._events_outputs = ColumnFunction(self._events_outputs_function()) if merged else False
-        return self._events_outputs or None
-
     def native_events_outputs(self):
-        """:meth:`events_outputs` compiled to machine code as one function, or None.
+        """Column function of the scaled event functions followed by the outputs, compiled to machine
+        code as one function (shared subexpressions evaluated once), or None.
 
         Only for a mode whose event functions call tables, where :meth:`event_values` and
-        :meth:`native_outputs_on` are both compiled (bao2020, locked: 159 and 373 instructions,
-        377 together); a merged compiled function next to events evaluated by numpy or CasADi would
-        change them by rounding.
+        :meth:`native_outputs_on` are both compiled: the compiled code performs the same operations
+        on the same numbers as the two separate functions, so each value is bit for bit theirs
+        (tested). Elsewhere the events are evaluated by numpy or CasADi and a merged compiled
+        function would change them by rounding. A locked mode's events (static capacity against
+        the torque to hold) repeat much of its outputs: bao2020, 159 and 373 instructions, 377
+        together.
         """
         if self._native_events_outputs is None:
             merged = None
             if self.events and self.event_values(True) is not self.events_on:
-                compiled = compile_columns(self._events_outputs_function())
+                args = [self.xs, self.zs, self.pu, self.t]
+                both = ca.Function(f"{self.name}_events_outputs", args,
+                                   [ca.densify(ca.cse(ca.vertcat(self.f_events(*args), self.f_outputs(*args))))])
+                compiled = compile_columns(both)
                 merged = ColumnFunction(compiled[0], loop=compiled[1]) if compiled is not None else None
             self._native_events_outputs = merged or False
         return self._native_events_outputs or None

@@ -148,19 +148,13 @@ def _outputs_on(evaluate, xs, zs, blocks_pu, t):
 
 def _outputs_completed(evaluate, n_out, blocks):
     """Outputs on all samples of a segment whose grid blocks carry them already (evaluated with the
-    events, :meth:`~clutchocp.simulation.compiled.CompiledMode.events_outputs`).
-
-    Every sample gets the value the segment's outputs ``evaluate`` would give it in one call on all
-    of them: a block keeps its outputs only if they were evaluated with the engine
-    (:meth:`~clutchocp.simulation.compiled.ColumnFunction.engine`) ``evaluate`` takes for the
-    whole segment (the same operations on the same numbers, bit for bit); the other blocks (single
-    samples at events and input breaks, short grid blocks) are evaluated by ``evaluate`` with that
-    engine, in one call per run of equal inputs.
-    """
-    engine = evaluate.engine(sum(b[0].size for b in blocks))
+    events, :meth:`~clutchocp.simulation.compiled.CompiledMode.native_events_outputs`): the other
+    blocks (single samples at events and input breaks) by ``evaluate``, the mode's compiled
+    outputs, in one call per run of equal inputs. Compiled code gives each sample the same value
+    whatever the samples evaluated with it."""
     parts, missing = [], []
     for b in blocks:
-        if b[4] is None or b[5] != engine:
+        if b[4] is None:
             if missing and np.array_equal(missing[-1][0], b[3]):
                 missing[-1][1].append(len(parts))
             else:
@@ -171,7 +165,7 @@ def _outputs_completed(evaluate, n_out, blocks):
     for pu, idx in missing:
         group = [blocks[i] for i in idx]
         y = evaluate(np.concatenate([b[1] for b in group], axis=1), np.concatenate([b[2] for b in group], axis=1), pu,
-                     np.concatenate([b[0] for b in group]), engine=engine)
+                     np.concatenate([b[0] for b in group]))
         start = 0
         for i in idx:
             size = blocks[i][0].size
@@ -192,19 +186,18 @@ class _Run:
 
     # ------------------------------------------------------------- samples
     def _begin(self, cm):
-        # blocks of (t (n,), xs (nx, n), zs (nz, n), pu (npu,), outputs (n_out, n) or None if not yet evaluated,
-        # the engine that evaluated them)
+        # blocks of (t (n,), xs (nx, n), zs (nz, n), pu (npu,), outputs (n_out, n) or None if not yet evaluated)
         self._segments.append([cm, []])
 
     def _add(self, t, xs, zs, pu):
         self._add_block(np.array([float(t)]), xs, zs, pu)
 
-    def _add_block(self, t, xs, zs, pu, y=None, engine=None):
+    def _add_block(self, t, xs, zs, pu, y=None):
         n = np.size(t)
         if n:
             cm = self._segments[-1][0]
             self._segments[-1][1].append((np.asarray(t, float).reshape(n), np.asarray(xs, float).reshape(cm.nx, n),
-                                          np.asarray(zs, float).reshape(cm.nz, n), np.asarray(pu, float), y, engine))
+                                          np.asarray(zs, float).reshape(cm.nz, n), np.asarray(pu, float), y))
 
     def segments(self):
         out = []
@@ -213,7 +206,7 @@ class _Run:
             xs = np.concatenate([b[1] for b in blocks], axis=1) if blocks else np.zeros((cm.nx, 0))
             zs = np.concatenate([b[2] for b in blocks], axis=1) if blocks else np.zeros((cm.nz, 0))
             if any(b[4] is not None for b in blocks):
-                y = _outputs_completed(self._outputs_function(cm), len(cm.output_names), blocks)
+                y = _outputs_completed(cm.native_outputs_on(), len(cm.output_names), blocks)
             else:
                 runs = []
                 for b in blocks:                      # consecutive blocks with the same inputs share one call
@@ -221,16 +214,12 @@ class _Run:
                         runs[-1][1] += b[0].size
                     else:
                         runs.append([b[3], b[0].size])
-                y = _outputs_on(self._outputs_function(cm), xs, zs, runs, t)
+                y = _outputs_on(cm.native_outputs_on() if self.opts.native else cm.outputs_on, xs, zs, runs, t)
             out.append(Segment(cm.name, t,
                                {k: xs[j] * cm.x_nominal[j] for j, k in enumerate(cm.x_names)},
                                {k: zs[j] * cm.z_nominal[j] for j, k in enumerate(cm.z_names)},
                                {k: y[j] for j, k in enumerate(cm.output_names)}))
         return out
-
-    def _outputs_function(self, cm):
-        """The column function of ``cm``'s outputs on the grid: compiled with ``native``."""
-        return cm.native_outputs_on() if self.opts.native else cm.outputs_on
 
     # ------------------------------------------------------------- mode entry and switches
     def start(self, cm, xs, z_guess):
@@ -301,8 +290,7 @@ class _Run:
             inner = self.grid[(self.grid > self.t + self.tiny) & (self.grid < t_end - self.tiny)]
             times = np.append(inner, t_end)
             adv = self.path.advance(self.cm, self.t, self.xs, self.zs, self.pu, times, self.monitor)
-            for t, xs, zs, y, engine in adv.parts or [(adv.t, adv.xs, adv.zs, None, None)]:
-                self._add_block(t, xs, zs, self.pu, y, engine)
+            self._add_block(adv.t, adv.xs, adv.zs, self.pu, adv.y)
             crossing = adv.crossing
             if crossing is None:
                 self.t, self.xs, self.zs = t_end, adv.xs[:, -1], adv.zs[:, -1]

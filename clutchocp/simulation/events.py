@@ -46,8 +46,7 @@ class Advance:
     xs: np.ndarray      # (nx, n)
     zs: np.ndarray      # (nz, n)
     crossing: Crossing | None = None
-    parts: list | None = None       # the samples as blocks (t, xs, zs, outputs (n_out, k) or None if not
-                                    # evaluated, the ColumnFunction.engine that evaluated them)
+    y: np.ndarray | None = None     # (n_outputs, n): the mode's outputs on the samples, if already evaluated
 
 
 class EventMonitor:

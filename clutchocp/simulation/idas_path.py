@@ -49,10 +49,10 @@ a restart at the first grid point 2000). With ``chunk`` given, calls cover ``chu
 intervals, growing by ``chunk_growth``. Mode integrations use ``native_dae`` instead of
 ``dae_tau`` when ``native=True`` (see :mod:`clutchocp.simulation.native`).
 
-The scaled event functions are evaluated on the outputs (in a mode whose event functions call
-tables, together with the mode's outputs in one function:
-:meth:`~clutchocp.simulation.compiled.CompiledMode.events_outputs`, compiled with ``native=True``;
-the outputs of the grid samples kept go back to the driver in ``Advance.parts``); at the first sign change the
+The scaled event functions are evaluated on the outputs (with ``native=True``, in a mode whose
+event functions call tables, together with the mode's outputs in one compiled function:
+:meth:`~clutchocp.simulation.compiled.CompiledMode.native_events_outputs`; the outputs of the
+grid samples kept go back to the driver in ``Advance.y``); at the first sign change the
 crossing is located by short IDAS integrations started from the latest point known to lie
 before it: a cubic Hermite interpolant of the grid values gives the first trial time, then
 safeguarded secant steps (:func:`~clutchocp.simulation.events.locate`) until the bracket is
@@ -363,11 +363,10 @@ class IdasPath:
                     continue
                 failure = fail                  # one interval: go as far as IDAS can, look for an event there
                 targets, xs, zs = self._reach(cm, left, pu, targets[0], fail, monitor)
-            y, engine = None, None
-            merged = cm.events_outputs(o.native) if t_probe is None and failure is None else None
+            y = None
+            merged = cm.native_events_outputs() if o.native and t_probe is None and failure is None else None
             if merged is not None:          # grid samples: their outputs with the events, in one call
-                engine = merged.engine(targets.size)
-                both = merged(xs, zs, pu, targets, engine=engine)
+                both = merged(xs, zs, pu, targets)
                 s, y = both[:len(cm.events)], both[len(cm.events):]
             else:
                 s = self._events(cm, xs, zs, pu, targets)
@@ -375,7 +374,7 @@ class IdasPath:
             if j is not None:
                 right = _Point(targets[j], xs[:, j], zs[:, j], s[:, j])
                 if j > 0 and t_probe is None and failure is None:
-                    blocks.append((targets[:j], xs[:, :j], zs[:, :j], y[:, :j] if y is not None else None, engine))
+                    blocks.append((targets[:j], xs[:, :j], zs[:, :j], y[:, :j] if y is not None else None))
                 if j > 0:
                     left = _Point(targets[j - 1], xs[:, j - 1], zs[:, j - 1], s[:, j - 1])
                 crossing = self._locate(cm, pu, left, right, crossings)
@@ -386,7 +385,7 @@ class IdasPath:
             if t_probe is not None:
                 probes += 1
                 continue
-            blocks.append((targets, xs, zs, y, engine))
+            blocks.append((targets, xs, zs, y))
             start += targets.size
             probes = 0
         return _advance(blocks, cm, None)
@@ -539,11 +538,9 @@ class IdasPath:
 
 
 def _advance(blocks, cm, crossing):
-    """The samples of ``blocks`` (t, xs, zs, outputs or None, the engine that evaluated them) as one
-    :class:`Advance`; the blocks themselves go along as its ``parts``."""
     if not blocks:
         return Advance(np.zeros(0), np.zeros((cm.nx, 0)), np.zeros((cm.nz, 0)), crossing)
     t = np.concatenate([b[0] for b in blocks])
+    y = np.concatenate([b[3] for b in blocks], axis=1) if all(b[3] is not None for b in blocks) else None
     return Advance(t, np.concatenate([np.reshape(b[1], (cm.nx, b[0].size)) for b in blocks], axis=1),
-                   np.concatenate([np.reshape(b[2], (cm.nz, b[0].size)) for b in blocks], axis=1), crossing,
-                   parts=blocks)
+                   np.concatenate([np.reshape(b[2], (cm.nz, b[0].size)) for b in blocks], axis=1), crossing, y)

@@ -344,37 +344,3 @@ def test_one_sample_calls_through_bound_buffers_equal_casadi_calls():
             column(np.zeros((2, 5)), np.zeros((0, 5)), p, np.zeros(5))
             assert 1 not in column._maps
     assert all(np.array_equal(got[:, 0], reference) for got, reference in kept)   # earlier results untouched
-
-
-def test_events_and_outputs_on_the_virtual_machine_path_equal_the_separate_functions(driveline_runs, monkeypatch):
-    """Without native code a mode whose events call tables (default_driveline, locked) also evaluates
-    its grid samples' events and outputs in one function: its rows equal the event function and the
-    outputs bit for bit on every engine (numpy on many samples, CasADi on few), on the strided
-    states an integrator call returns too, and the run equals the run with separate evaluations
-    bit for bit (the outputs of samples another engine evaluated are evaluated again)."""
-    from clutchocp.engagement.model import EngagementModel
-    from clutchocp.engagement.run import simulate_engagement
-    from clutchocp.simulation.compiled import CompiledMode
-
-    model, runs = driveline_runs
-    compiled = model.hybrid.compiled()
-    locked = compiled["pressing_locked"]
-    merged = locked.events_outputs()
-    assert merged is not None and compiled["pressing_slip_forward"].events_outputs() is None   # no table call
-    seg = next(s for s in runs["vm"].result.segments if s.mode == "pressing_locked")
-    xs = np.array([seg.x[k] / nominal for k, nominal in zip(locked.x_names, locked.x_nominal)])
-    strided = np.array(xs.T).T                       # as the integrator's (n, nx) output, transposed
-    zs, pu = np.zeros((0, seg.t.size)), np.zeros(locked.pu.numel())
-    n_events = len(locked.events)
-    for k in (seg.t.size, 3):
-        assert merged.engine(k) == locked.outputs_on.engine(k) == ("numpy" if k > 128 else "casadi")
-        both = merged(strided[:, :k], zs[:, :k], pu, seg.t[:k])
-        assert np.array_equal(both[:n_events], locked.events_on(xs[:, :k], zs[:, :k], pu, seg.t[:k]), equal_nan=True)
-        assert np.array_equal(both[n_events:], locked.outputs_on(xs[:, :k], zs[:, :k], pu, seg.t[:k]), equal_nan=True)
-    monkeypatch.setattr(CompiledMode, "events_outputs", lambda self, native=False: None)
-    separate = simulate_engagement(model.scene, model=EngagementModel(model.scene))
-    a, b = runs["vm"].series(), separate.series()
-    for name in a:
-        if name != "mode":
-            assert np.array_equal(a[name], b[name], equal_nan=True), name
-    assert runs["vm"].summary["events"] == separate.summary["events"]

@@ -59,6 +59,19 @@ def test_crossing_and_peak_of_a_cubic_are_exact():
     assert crossing_time(t, t**3, 2.0) is None
 
 
+@pytest.mark.parametrize("c", [0.013, 0.51, 0.987])
+def test_crossing_and_peak_near_the_ends_and_pieces_of_the_samples_are_exact(c):
+    """A crossing and a peak in the first, a middle and the last sample interval, the local
+    polynomial's samples limited to one piece (labels as the modes of a run, array or list): each
+    is exact for samples of a cubic (crossing of t^3 at c^3) and of a parabola (peak of -(t - c)^2)."""
+    t = np.linspace(0.0, 1.0, 41)
+    piece = np.where(t < 0.5, "slip", "locked")
+    for labels in (None, piece, list(piece)):
+        assert crossing_time(t, t**3, c**3, labels) == pytest.approx(c, abs=1e-12)
+        value, at = peak(t, -(t - c) ** 2, labels)
+        assert at == pytest.approx(c, abs=1e-12) and value == pytest.approx(0.0, abs=1e-13)
+
+
 def test_padded_sizes_are_at_most_a_quarter_larger_and_few():
     from clutchocp.simulation.vectorized import padded_size
 

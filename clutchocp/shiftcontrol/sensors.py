@@ -98,6 +98,9 @@ class SpeedSensor:
         pitch = 2 * math.pi / self.teeth
         if self.method == "counting":
             return (pitch / sample_time) ** 2 / 6.0 + noise
+        if self.learned_revolutions:
+            # learned pitches: the reading's error is that of its two boundary edges (independent of each other)
+            return 2 * self.boundary_variance(speed) / sample_time ** 2 + noise
         n = max(abs(speed) * sample_time / pitch, 1.0)         # teeth passed in one sample
         r = n % self.teeth                                     # whole revolutions carry no pitch error
         pitch_sum = self.pitch_error ** 2 / 3 * r * (1 - r / self.teeth)     # var of the sum of r of Z closing errors

@@ -121,6 +121,8 @@ def test_reading_variance_matches_the_sensor_model():
     """The variance the Kalman filter is designed with against the spread of many realised sensors (speeds
     drawn over a band, so that a count's fractional part is spread as the model averages it)."""
     for sensor in (SpeedSensor("edge_timing", teeth=60, timer_resolution=1e-6, pitch_error=0.005),
+                   SpeedSensor("edge_timing", teeth=60, timer_resolution=1e-6, pitch_error=0.005,
+                               learned_revolutions=50),
                    SpeedSensor("edge_timing", teeth=60, timer_resolution=2e-5),
                    SpeedSensor("counting", teeth=60),
                    SpeedSensor("ideal", noise=0.3)):

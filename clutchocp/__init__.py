@@ -65,7 +65,8 @@ def optimize(scene=None, *, overrides=None, t_max=None, weights=None, intervals=
     overrides : dict, optional
         ``{"part.key": value}`` replacing scene values.
     t_max : float, optional
-        Largest engagement time [s] (default: the lock-up time of the scene's own profile).
+        Largest engagement time [s] (default: the scene's ``actuation.engagement_time_limit``, else the
+        lock-up time of the scene's own profile).
     weights : dict, optional
         Objective weights ``jerk``, ``energy``, ``time``, ``jump``, ``smooth`` (see the README;
         defaults jerk = 1, smooth = 0.1 x jerk, the others 0).

@@ -204,7 +204,9 @@ def _add_optimize(sub):
     p.add_argument("--out", default="out/optimize", help="output folder (default: out/optimize)")
     p.add_argument("--set", action="append", default=[], metavar="PART.KEY=VALUE",
                    help="override a scene value, e.g. --set actuation.max_pressure='1.2 MPa' (repeatable)")
-    p.add_argument("--t-max", type=time_limit, default=None, help="largest engagement time [s]")
+    p.add_argument("--t-max", type=time_limit, default=None,
+                   help="largest engagement time [s] (default: the scene's actuation.engagement_time_limit, else "
+                        "the lock-up time of its own profile)")
     p.add_argument("--weights", default=None, metavar="NAME=W,...",
                    help="objective weights, e.g. jerk=1,energy=10. Objective: jerk x (int jerk^2 dt)/J_ref "
                         "+ energy x E/E_ref + time x t_f/t_ref + jump x (torque jump/locked torque)^2 + smooth "
@@ -252,7 +254,8 @@ def _add_control_commands(sub):
     p.add_argument("--uncertain", action="append", default=[], metavar="PART.KEY=SPEC",
                    help="add or replace an uncertain field, e.g. --uncertain 'friction.mu=uniform 10 %%' (repeatable)")
     p.add_argument("--t-max", type=time_limit, default=None,
-                   help="engagement-time limit [s] (default: lock-up time of the scene's own profile)")
+                   help="engagement-time limit [s] (default: the scene's actuation.engagement_time_limit, else the "
+                        "lock-up time of its own profile)")
     p.add_argument("--controller", default="slip_lqr", help="slip-feedback spec name or TOML file (default: slip_lqr)")
     p.add_argument("--workers", type=count(1, 1024, "parallel processes"), default=None,
                    help="parallel processes (default: the local cores)")
@@ -297,7 +300,8 @@ def _add_sweep(sub):
                    help="simulate: compiled C code: auto (default) for a model reused over the points, where "
                         "a C compiler exists; on: also for one model per point (1-4 s each); off: never")
     p.add_argument("--t-max", type=time_limit, default=None,
-                   help="optimize: largest engagement time [s] (default: each point's own baseline lock-up time)")
+                   help="optimize: largest engagement time [s] (default: the scene's "
+                        "actuation.engagement_time_limit, else each point's own baseline lock-up time)")
     p.add_argument("--weights", default=None, metavar="NAME=W,...", help="optimize: objective weights")
     p.add_argument("--intervals", type=count(2, MAX_INTERVALS, "collocation intervals"), default=40,
                    help="optimize: collocation intervals (default: 40)")

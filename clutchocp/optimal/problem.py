@@ -1043,10 +1043,18 @@ class EngagementOCP:
         return [np.repeat(value[:, None], n, axis=1)]
 
     # -- feasibility ----------------------------------------------------------------------------
+    @property
+    def declared_t_max(self):
+        """The scene's own engagement-time budget, ``actuation.engagement_time_limit`` [s] (None if absent)."""
+        return self.scene.get("actuation.engagement_time_limit")
+
     def default_t_max(self):
-        """The baseline's lock-up time (no slower than the scene's own profile), or 1.5 x the fastest
-        lock-up if the baseline does not lock up or is itself the fastest lock-up (bao2020: the spring
-        applies the clutch at once; no smooth lock-up can be as fast) [s]."""
+        """The scene's ``actuation.engagement_time_limit`` if it declares one; else the baseline's lock-up
+        time (no slower than the scene's own profile), or 1.5 x the fastest lock-up if the baseline does not
+        lock up or is itself the fastest lock-up (bao2020: the spring applies the clutch at once; no smooth
+        lock-up can be as fast) [s]."""
+        if self.declared_t_max is not None:
+            return float(self.declared_t_max)
         t_lock = self.baseline.summary["engagement_time_s"]
         if t_lock is None or t_lock <= 1.001 * self.fastest_lockup():
             return 1.5 * self.fastest_lockup()
@@ -1054,6 +1062,8 @@ class EngagementOCP:
 
     def default_t_max_source(self):
         """Where :meth:`default_t_max` comes from, in words (for progress lines and summary.json)."""
+        if self.declared_t_max is not None:
+            return "the scene's engagement-time budget (actuation.engagement_time_limit)"
         t_lock = self.baseline.summary["engagement_time_s"]
         if t_lock is None:
             return f"1.5 x the fastest lock-up (a step to {self.apply_label()}): the scene's own profile does not lock up"

@@ -48,7 +48,8 @@ def run_optimize(scene=None, out_dir="out/optimize", t_max=None, weights=None, i
         Output folder (created): pressure_profile.csv, timeseries.csv (the IDAS replay of the optimum, the
         columns of the simulate command), summary.json, PNG figures.
     t_max : float, optional
-        Largest engagement time [s] (default: the lock-up time of the scene's own profile;
+        Largest engagement time [s] (default: the scene's ``actuation.engagement_time_limit``, else the
+        lock-up time of the scene's own profile;
         ``numpy.inf``: none, then weight the time or the energy).
     weights : dict, optional
         Objective weights (jerk, energy, time, jump, smooth); see ``clutchocp.optimal.problem``.

@@ -76,7 +76,8 @@ def solve_robustly(ocp, *, t_max=None, weights=None, e_max=None, guess=None, say
     """
     say = say or (lambda *a, **k: None)
     given = t_max is not None
-    adapt = (not given) if adapt_t_max is None else bool(adapt_t_max)
+    # a limit the user gives (--t-max, or the scene's engagement-time budget) is a specification: not adapted
+    adapt = (not given and ocp.declared_t_max is None) if adapt_t_max is None else bool(adapt_t_max)
     t_max = ocp.default_t_max() if t_max is None else float(t_max)
     weights = check_weights(weights)
     info = {"t_max_source": "given" if given else ocp.default_t_max_source(), "attempts": []}
@@ -129,7 +130,7 @@ def solve_robustly(ocp, *, t_max=None, weights=None, e_max=None, guess=None, say
     info["fastest_lockup_s"] = t_star
     if t_star > t_max * (1 + T_MAX_TOLERANCE):
         if not adapt:
-            raise ModelError(too_slow_message(ocp, t_max, t_star))
+            raise ModelError(too_slow_message(ocp, t_max, t_star, declared=not given))
         t_max = DEFAULT_T_MAX_SLACK * t_star
         info["t_max_source"] = f"{DEFAULT_T_MAX_SLACK:g} x the fastest lock-up that meets the end conditions"
         say(f"  the scene's own profile locks up sooner than any command that meets the end conditions can: "
@@ -142,14 +143,16 @@ def solve_robustly(ocp, *, t_max=None, weights=None, e_max=None, guess=None, say
     return opt, t_max, info
 
 
-def too_slow_message(ocp, t_max, t_star):
-    """One line: t_max below the fastest lock-up that meets the end conditions, and the number to give."""
+def too_slow_message(ocp, t_max, t_star, declared=False):
+    """One line: t_max below the fastest lock-up that meets the end conditions, and the number to give
+    (``declared``: t_max is the scene's ``actuation.engagement_time_limit``, named as the field to raise)."""
     step = ocp.fastest_lockup()
     limits = [f"a step to {ocp.apply_label()} locks up in {step:.4g} s but with a torque jump"]
     if ocp.heat_limits:
         limits.append("within the heat limits")
     return (f"scene '{ocp.scene.name}': t_max = {t_max:.4g} s is below the fastest lock-up that meets the end "
-            f"conditions (slipping torque = the locked torque, the lock holding): --t-max must be at least "
+            f"conditions (slipping torque = the locked torque, the lock holding): "
+            f"{'actuation.engagement_time_limit (or --t-max)' if declared else '--t-max'} must be at least "
             f"{t_star:.4g} s for this clutch ({'; '.join(limits)}), or raise actuation.max_pressure")
 
 

@@ -148,6 +148,7 @@ ROUGHNESS = Span((1e-8, 3e-5), (1e-10, 1e-3), "an RMS surface roughness", zero=T
 MODULUS = Span((1e6, 3e11), (1e4, 1e12), "an elastic modulus")
 STRENGTH = Span((1e6, 1e10), (1e4, 1e11), "a hardness or yield strength")
 TIME_CONSTANT = Span((1e-4, 5.0), (1e-7, 1e3), "a valve or pressure time constant")
+ENGAGEMENT_TIME = Span((0.05, 5.0), (1e-3, 100.0), "a clutch engagement (slip-phase) time")
 TEMPERATURE = Span((-40.0, 200.0), (-100.0, 500.0), "an oil or plate temperature")
 HEAT_CAPACITY = Span((1.0, 1e5), (1e-3, 1e8), "a plate-pack heat capacity")
 PISTON_AREA = Span((1e-4, 0.5), (1e-6, 10.0), "a piston area")
@@ -409,6 +410,10 @@ PARTS = {
                          "area the pressure acts on when there is no piston [m^2] (default: plate area)",
                          span=PISTON_AREA),
             "max_pressure": QOpt("Pa", None, "positive_pressure", "upper pressure limit [Pa]", span=PRESSURE),
+            "engagement_time_limit": QOpt("s", None, "positive",
+                                          "the shift's budget for the slip phase [s]: the engagement-time limit "
+                                          "t_max of optimize and robust when --t-max is not given (absent: the "
+                                          "lock-up time of the scene's own profile)", span=ENGAGEMENT_TIME),
         },
         variants={
             "step": {},

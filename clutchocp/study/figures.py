@@ -266,7 +266,7 @@ def _curves(out, scene, task, rows, fields):
     ax.set_xlabel("time [s]")
     ax.set_ylabel("optimal pressure command [MPa]")
     ax.grid(True, alpha=0.3)
-    t_max = task.options.get("t_max")
+    t_max = task.options.get("t_max") or scene.get("actuation.engagement_time_limit")
     limit = f"t_max = {t_max:g} s" if t_max else "t_max = each point's own baseline lock-up time"
     fig.suptitle(scene_title(scene.name, f"optimal engagement pressure, {len(by_point)} operating points",
                              task.base_overrides) + "\n"

@@ -72,8 +72,8 @@ class Task:
         ``atol``, ``reuse_model`` (bool, default True: one model per worker with the swept fields
         as parameters, :mod:`clutchocp.study.parametric`, where the model allows it; False: a new
         model per point, bit for bit the single-run results), ``native`` (``"auto"``, default:
-        compiled C for a reused model where a C compiler exists; True: for every model; False: never). optimize: ``intervals``, ``degree``, ``t_max`` [s] (None: each
-        point's own baseline lock time), ``weights``, ``warm_start`` (bool, default True),
+        compiled C for a reused model where a C compiler exists; True: for every model; False: never). optimize: ``intervals``, ``degree``, ``t_max`` [s] (None: the scene's
+        ``actuation.engagement_time_limit``, else each point's own baseline lock time), ``weights``, ``warm_start`` (bool, default True),
         ``verify`` (bool, default True: replay each optimum with IDAS), ``reuse_problem`` (bool,
         default True: one collocation problem per worker with the swept fields as parameters,
         :mod:`clutchocp.study.parametric_ocp`, where the problem allows it; False: a new problem

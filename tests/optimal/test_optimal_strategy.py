@@ -34,12 +34,31 @@ def test_a_t_max_the_end_conditions_cannot_meet_is_refused_with_the_fastest_jump
     assert opt.success and opt.t_f <= 1.001 * t_star * (1 + 1e-6)
 
 
+def test_the_scene_engagement_time_budget_is_the_default_t_max_and_is_not_adapted(small):
+    """The default scene declares actuation.engagement_time_limit = 0.3 s: that is the default t_max (its own
+    profile locks at 0.135 s); a declared budget the end conditions cannot meet is refused naming the field,
+    not raised as the baseline's lock-up time would be."""
+    assert small.default_t_max() == 0.3 and "actuation.engagement_time_limit" in small.default_t_max_source()
+    plain = EngagementOCP(default_scene().with_overrides({"actuation.engagement_time_limit": None}), intervals=15,
+                          degree=2)
+    assert plain.default_t_max() == pytest.approx(plain.baseline.summary["engagement_time_s"])
+    assert 0.13 < plain.default_t_max() < 0.14 and "own profile" in plain.default_t_max_source()
+    short = 1.02 * small.fastest_lockup()
+    tight = EngagementOCP(default_scene().with_overrides({"actuation.engagement_time_limit": short}), intervals=15,
+                          degree=2)
+    with pytest.raises(ModelError) as info:
+        solve_robustly(tight)
+    message = str(info.value)
+    assert "\n" not in message and "actuation.engagement_time_limit (or --t-max) must be at least" in message
+
+
 @pytest.mark.slow
 def test_a_default_t_max_faster_than_any_jump_free_lock_is_raised():
     """default_driveline with a larger pack (75-98 mm, 6 interfaces): its own profile locks in 0.1195 s with
     a jump of 480 N m; no jump-free lock is that fast. Without a t_max the problem is solved for 1.1 x the
     fastest jump-free lock-up; with t_max = 0.1195 s given, that lock-up is the number the refusal names."""
-    ocp = EngagementOCP(default_scene().with_overrides(BIG_PACK), intervals=40)
+    ocp = EngagementOCP(default_scene().with_overrides({**BIG_PACK, "actuation.engagement_time_limit": None}),
+                        intervals=40)
     opt, t_max, info = solve_robustly(ocp)
     t_star = info["fastest_lockup_s"]
     assert t_star > ocp.default_t_max() and t_max == pytest.approx(DEFAULT_T_MAX_SLACK * t_star)
@@ -52,6 +71,8 @@ def test_a_default_t_max_faster_than_any_jump_free_lock_is_raised():
 class _LocallyInfeasibleWithTheAdaptiveBarrier:
     """A problem whose adaptive barrier update ends at a local point of infeasibility and whose monotone one
     converges from the same start (as bao2020_as_published's first solve on 60 slip intervals did)."""
+
+    declared_t_max = None
 
     def __init__(self):
         self.calls = []

@@ -43,12 +43,10 @@ def test_closed_loop_on_the_nominal_clutch_reproduces_the_open_loop_optimum(desi
     assert tcu["handover_s"] is not None
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "measured on the transmitted shear factor (phi_f + Phi_fs over the nominal film h) and the film tension "
-    "limit: on the clutch with 10 % less friction the open loop locks at 0.221 s with a jump of 16.1 % of the "
-    "locked torque, the slip feedback at 0.151 s (earlier than the nominal optimum's 0.157 s) with 40.5 %: the "
-    "feedback designed on the default scene now pushes the weaker clutch into a faster, harder lock"))
 def test_feedback_cuts_the_jump_on_a_clutch_with_less_friction(designed):
+    """On the default scene's 0.3 s budget. (At the lock-up time of its own step, 0.135 s, the optimum rides the
+    pressure limits and this feedback pushed the weaker clutch into a faster, harder lock: 40.5 % against the
+    open loop's 16.1 %.)"""
     scene, opt, design, times, values = designed
     other = scene.with_overrides({"friction.mu": 0.9 * scene.value("friction.mu")})
     t_end = 2.5 * opt.t_f          # the open loop locks late (measured: 1.78 t_f)

@@ -1123,8 +1123,9 @@ class EngagementOCP:
             return
         fastest = self.fastest_lockup()
         if t_max < fastest:
+            field = "actuation.engagement_time_limit (or --t-max)" if t_max == self.declared_t_max else "--t-max"
             raise ModelError(f"scene '{self.scene.name}': t_max = {t_max:.4g} s is below the fastest lock-up the "
-                             f"pressure limit allows: --t-max must be at least {fastest:.4g} s for this clutch (a step "
+                             f"pressure limit allows: {field} must be at least {fastest:.4g} s for this clutch (a step "
                              f"to {self.apply_label()} locks up then), or raise actuation.max_pressure")
 
 

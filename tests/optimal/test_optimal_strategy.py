@@ -50,6 +50,10 @@ def test_the_scene_engagement_time_budget_is_the_default_t_max_and_is_not_adapte
         solve_robustly(tight)
     message = str(info.value)
     assert "\n" not in message and "actuation.engagement_time_limit (or --t-max) must be at least" in message
+    step = EngagementOCP(default_scene().with_overrides({"actuation.engagement_time_limit": 0.05}), intervals=15,
+                         degree=2)                            # below even a step to the pressure limit
+    with pytest.raises(ModelError, match=r"actuation.engagement_time_limit \(or --t-max\) must be at least"):
+        solve_robustly(step)
 
 
 @pytest.mark.slow

@@ -126,8 +126,21 @@ def energy_balance(model, result):
     return out
 
 
+def summary_outputs(model):
+    """The outputs :func:`summarize` reads, which it evaluates together (one call per segment,
+    :meth:`~clutchocp.simulation.result.SimulationResult.load`)."""
+    names = ["pressure_Pa", "total_torque_Nm", "contact_torque_Nm", "output_jerk_rad_s3", "kinetic_energy_J",
+             "spring_energy_J", "interface_heat_power_W"]
+    for i in range(model.n):
+        names += [f"film_{i + 1}_mean_pressure_Pa", f"film_{i + 1}_fluid_force_N"]
+    if model.thermal.present:
+        names += ["stored_heat_J", "interface_temperature_C", "friction_plate_temperature_C"]
+    return names
+
+
 def summarize(model, result, wall_time, options, method):
     """The numbers of an engagement (JSON-ready; units in the key names)."""
+    result.load(summary_outputs(model))
     locks = [e for e in result.events if e.name == "lockup" and e.target.endswith("locked")]
     locked_at_end = str(result.final_mode).endswith("locked")
     lock = locks[-1] if locks and locked_at_end else None

@@ -77,6 +77,7 @@ class EngagementResult:
         microseconds, bao2020's plate impact, is not resolved by any output grid).
         """
         res = self.result
+        res.load(res.names())                  # every output: one call per segment
         columns = {"time_s": res.t, "mode": res.mode}
         for name in self.model.state_names:
             if not name.startswith("E_"):

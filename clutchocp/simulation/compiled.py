@@ -65,10 +65,12 @@ class ColumnFunction:
     evaluation for a few thousand samples of a small function). ``loop``, for a function compiled
     to machine code: its loop over samples (:func:`clutchocp.simulation.native.compile_columns`),
     used instead of the map (the same compiled function on every sample, without CasADi's calling
-    machinery around each call).
+    machinery around each call). ``like``: a column function of which ``function`` computes some
+    outputs (:meth:`CompiledMode.outputs_subset`); its choice between numpy and the map is taken
+    on the same samples, so each value is bit for bit the one ``like`` gives.
     """
 
-    def __init__(self, function, max_maps=32, loop=None):
+    def __init__(self, function, max_maps=32, loop=None, like=None):
         if not all(function.sparsity_in(i).is_dense() for i in range(4)) or not function.sparsity_out(0).is_dense():
             raise ModelError(f"{function.name()}: a column function needs dense inputs and output (densify them)")
         self.function = function
@@ -76,7 +78,9 @@ class ColumnFunction:
         self.n_out = function.size1_out(0)
         self._maps = {}
         self._max_maps = max_maps
-        self._calls = vectorized.calls_unregistered(function)
+        self._calls = like._calls if like is not None else vectorized.calls_unregistered(function)
+        self._like = like
+        self._translatable = None
         self._numpy_built = False
         self._numpy_fn = None
         self._loop = loop
@@ -88,8 +92,16 @@ class ColumnFunction:
         use: a run whose output pieces are all shorter than the threshold (MIN_SAMPLES, or
         MIN_SAMPLES_PLAIN without calls of tables) never pays for it."""
         if not self._numpy_built:
-            self._numpy_fn, self._numpy_built = numpy_function(self.function), True
+            mirrored = self._like is None or self._like.translatable()
+            self._numpy_fn, self._numpy_built = numpy_function(self.function) if mirrored else None, True
         return self._numpy_fn
+
+    def translatable(self):
+        """Whether the function has a numpy form (found without building it)."""
+        if self._translatable is None:
+            self._translatable = self._numpy is not None if self._numpy_built else \
+                vectorized.translatable(self.function)
+        return self._translatable
 
     def _map(self, n):
         entry = self._maps.pop(n, None)
@@ -172,6 +184,7 @@ class CompiledMode:
         self.x_names = list(mode.x)
         self.z_names = list(mode.z)
         self.output_names = list(mode.outputs)
+        self.output_index = {name: i for i, name in enumerate(self.output_names)}
         self.x_nominal = mode.x_nominal
         self.z_nominal = mode.z_nominal
         self.z_guess_scaled = mode.z_guess / mode.z_nominal if mode.z else np.zeros(0)
@@ -193,9 +206,10 @@ class CompiledMode:
         self.alg_s = ca.cse(scaled(mode.alg) / ca.DM(mode.alg_nominal)) if self.nz else ca.SX(0, 1)
         self.f_ode = _function(f"{self.name}_ode", args, [self.ode_s], "the ode", self.name)
         self.f_alg = _function(f"{self.name}_alg", args, [self.alg_s], "the algebraic equations", self.name)
-        self.f_outputs = _function(f"{self.name}_outputs", args, [ca.densify(scaled(list(mode.outputs.values())))],
-                                   "an output", self.name)
+        self._outputs_s = ca.densify(scaled(list(mode.outputs.values())))
+        self.f_outputs = _function(f"{self.name}_outputs", args, [self._outputs_s], "an output", self.name)
         self.outputs_on = ColumnFunction(self.f_outputs)
+        self._output_subsets = {}
 
         # events: scaled functions, guards (>= 0 lets the event fire), shared-location keys
         self.events = []
@@ -263,6 +277,23 @@ class CompiledMode:
             self._event_slopes = ColumnFunction(ca.Function(
                 f"{self.name}_event_slopes", [self.xs, self.zs, self.pu, self.t], [ca.densify(ca.cse(ca.vertcat(s, s1, s2)))]))
         return self._event_slopes
+
+    def outputs_subset(self, indices):
+        """Column function of the outputs at ``indices`` (increasing positions in
+        :attr:`output_names`): :attr:`outputs_on` itself for all of them, else a Function of the
+        same expressions restricted to those outputs (built on first use and kept), evaluated the way
+        :attr:`outputs_on` would be on the same samples (numpy or CasADi's map), so each value is
+        bit for bit the one :attr:`outputs_on` gives, at the cost of the instructions those outputs
+        need (a summary reads ~15 of an engagement model's ~42 outputs)."""
+        key = tuple(int(i) for i in indices)
+        if key == tuple(range(len(self.output_names))):
+            return self.outputs_on
+        function = self._output_subsets.get(key)
+        if function is None:
+            subset = ca.Function(f"{self.name}_outputs_{len(key)}", [self.xs, self.zs, self.pu, self.t],
+                                 [self._outputs_s[list(key)] if key else ca.SX(0, 1)])
+            function = self._output_subsets[key] = ColumnFunction(subset, like=self.outputs_on)
+        return function
 
     def native_dae(self):
         """``dae_tau`` compiled to machine code (see :mod:`clutchocp.simulation.native`), or None."""

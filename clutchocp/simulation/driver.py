@@ -11,7 +11,7 @@ from clutchocp.simulation.events import ARMED, PASSED, EventMonitor
 from clutchocp.simulation.idas_path import IdasPath
 from clutchocp.simulation.model import PiecewiseConstant
 from clutchocp.simulation.options import METHODS, SimulationOptions
-from clutchocp.simulation.result import EventRecord, Segment, SimulationResult
+from clutchocp.simulation.result import EventRecord, LazyOutputs, Segment, SimulationResult
 from clutchocp.simulation.scipy_path import ScipyPath
 
 
@@ -174,6 +174,40 @@ def _outputs_completed(evaluate, n_out, blocks):
     return np.concatenate(parts, axis=1) if parts else np.zeros((n_out, 0))
 
 
+class _SegmentOutputs:
+    """The outputs of one segment, evaluated when first read (:class:`~clutchocp.simulation.result.LazyOutputs`).
+
+    Keeps the segment's scaled samples and its runs of equal inputs (the grid blocks too where they
+    carry outputs evaluated with the events); gives the same values as evaluating
+    every output at the end of the run: the same function on the same runs of equal inputs
+    (:func:`_outputs_on`), restricted to the outputs asked for on CasADi's virtual machine and
+    numpy (:meth:`~clutchocp.simulation.compiled.CompiledMode.outputs_subset`, the same operations);
+    compiled code and blocks that carry their outputs already (evaluated with the events) give
+    all the outputs at once.
+    """
+
+    def __init__(self, cm, blocks, t, xs, zs, native):
+        self.cm, self.t, self.xs, self.zs, self.native = cm, t, xs, zs, native
+        self.blocks = blocks if any(b[4] is not None for b in blocks) else None
+        self.runs = []
+        for b in blocks:                      # consecutive blocks with the same inputs share one call
+            if self.runs and np.array_equal(self.runs[-1][0], b[3]):
+                self.runs[-1][1] += b[0].size
+            else:
+                self.runs.append([b[3], b[0].size])
+
+    def __call__(self, names):
+        cm = self.cm
+        if self.blocks is not None:
+            return dict(zip(cm.output_names,
+                            _outputs_completed(cm.native_outputs_on(), len(cm.output_names), self.blocks)))
+        if self.native:
+            return dict(zip(cm.output_names, _outputs_on(cm.native_outputs_on(), self.xs, self.zs, self.runs, self.t)))
+        index = sorted(cm.output_index[n] for n in names)
+        y = _outputs_on(cm.outputs_subset(index), self.xs, self.zs, self.runs, self.t)
+        return {cm.output_names[i]: row for i, row in zip(index, y)}
+
+
 class _Run:
     """State of one hybrid simulation."""
 
@@ -205,20 +239,10 @@ class _Run:
             t = np.concatenate([b[0] for b in blocks]) if blocks else np.zeros(0)
             xs = np.concatenate([b[1] for b in blocks], axis=1) if blocks else np.zeros((cm.nx, 0))
             zs = np.concatenate([b[2] for b in blocks], axis=1) if blocks else np.zeros((cm.nz, 0))
-            if any(b[4] is not None for b in blocks):
-                y = _outputs_completed(cm.native_outputs_on(), len(cm.output_names), blocks)
-            else:
-                runs = []
-                for b in blocks:                      # consecutive blocks with the same inputs share one call
-                    if runs and np.array_equal(runs[-1][0], b[3]):
-                        runs[-1][1] += b[0].size
-                    else:
-                        runs.append([b[3], b[0].size])
-                y = _outputs_on(cm.native_outputs_on() if self.opts.native else cm.outputs_on, xs, zs, runs, t)
+            outputs = LazyOutputs(cm.output_names, _SegmentOutputs(cm, blocks, t, xs, zs, self.opts.native))
             out.append(Segment(cm.name, t,
                                {k: xs[j] * cm.x_nominal[j] for j, k in enumerate(cm.x_names)},
-                               {k: zs[j] * cm.z_nominal[j] for j, k in enumerate(cm.z_names)},
-                               {k: y[j] for j, k in enumerate(cm.output_names)}))
+                               {k: zs[j] * cm.z_nominal[j] for j, k in enumerate(cm.z_names)}, outputs))
         return out
 
     # ------------------------------------------------------------- mode entry and switches

@@ -1,5 +1,6 @@
 """Result of a hybrid simulation: samples, per-mode segments, events and solver statistics."""
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,9 +29,75 @@ class EventRecord:
     iterations: int = 0
 
 
+class LazyOutputs(Mapping):
+    """Outputs of a segment by name, each evaluated on all the segment's samples when first read
+    and kept.
+
+    A run's outputs (an engagement model has ~42) cost as much as a third of a warm run on its
+    output grid, and most readers need few of them (a summary ~15). ``evaluate(names)`` gives
+    ``{name: values}`` for at least ``names``; :meth:`load` asks it for several at once. Pickled
+    (a result sent to another process), the mapping is a plain dict of all the outputs.
+
+    Parameters
+    ----------
+    names : list of str
+        The outputs, in the mode's order.
+    evaluate : callable
+        ``evaluate(names) -> {name: array of the segment's samples}``.
+    """
+
+    def __init__(self, names, evaluate):
+        self._names = list(names)
+        self._known = set(self._names)
+        self._evaluate = evaluate
+        self._values = {}
+
+    def __getitem__(self, name):
+        values = self._values.get(name)
+        if values is None:
+            if name not in self._known:
+                raise KeyError(name)
+            self.load([name])
+            values = self._values[name]
+        return values
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self):
+        return len(self._names)
+
+    def __contains__(self, name):
+        return name in self._known
+
+    def load(self, names):
+        """Evaluate those of ``names`` that are outputs here and not yet evaluated, in one call
+        (other names are ignored)."""
+        missing = [n for n in dict.fromkeys(names) if n in self._known and n not in self._values]
+        if missing:
+            self._values.update(self._evaluate(missing))
+            if len(self._values) == len(self._names):
+                self._evaluate = None                 # everything is here: drop the samples kept for it
+
+    def evaluated(self):
+        """Names of the outputs evaluated so far."""
+        return [n for n in self._names if n in self._values]
+
+    def __reduce__(self):
+        self.load(self._names)
+        return dict, ({name: self._values[name] for name in self._names},)
+
+    def __repr__(self):
+        return f"LazyOutputs({len(self._names)} outputs, {len(self._values)} evaluated)"
+
+
 @dataclass
 class Segment:
-    """Samples of one stretch spent in one mode (unscaled, by name)."""
+    """Samples of one stretch spent in one mode (unscaled, by name).
+
+    ``outputs`` is a mapping by name: a dict, or :class:`LazyOutputs` evaluating each output on
+    first read.
+    """
 
     mode: str
     t: np.ndarray
@@ -62,6 +129,16 @@ class SimulationResult:
         mode = np.concatenate([np.full(s.t.size, s.mode, dtype=object) for s in segments]) \
             if segments else np.zeros(0, dtype=object)
         return cls(t=t, mode=mode, segments=segments, events=events, stats=stats)
+
+    def load(self, names):
+        """Evaluate the outputs ``names`` not evaluated yet, in one call per segment (names that
+        are not outputs of a segment's mode are skipped there): several outputs read together
+        share the subexpressions they have in common. Reading ``result[name]`` evaluates one output
+        by itself; the values are the same either way."""
+        names = list(names)
+        for seg in self.segments:
+            if isinstance(seg.outputs, LazyOutputs):
+                seg.outputs.load(names)
 
     def names(self):
         """Every state, algebraic variable and output name met in the run."""

@@ -217,17 +217,9 @@ def _pad(a, n, m):
     return out
 
 
-def numpy_function(function):
-    """``function`` (an SX Function with dense inputs and outputs) as a Python function of numpy arrays.
-
-    Returns
-    -------
-    callable or None
-        ``g(args, outs)``: ``args[i]`` indexable by nonzero (rows of an array of samples, or
-        scalars); ``outs[i][k]`` receives nonzero ``k`` of output ``i`` (a row, broadcast from a
-        scalar where the output does not depend on the sampled inputs). None when the function
-        holds an instruction that has no numpy counterpart here.
-    """
+def _source(function):
+    """Python source of :func:`numpy_function` (its lines and the functions it calls), or None when
+    the function holds an instruction that has no numpy counterpart here."""
     if not function.is_a("SXFunction"):
         return None
     lines, calls = ["def evaluate(args, outs):"], []
@@ -251,6 +243,29 @@ def numpy_function(function):
             return None
     if len(lines) == 1:
         lines.append("    pass")
+    return lines, calls
+
+
+def translatable(function):
+    """Whether :func:`numpy_function` translates ``function`` (without compiling the translation)."""
+    return _source(function) is not None
+
+
+def numpy_function(function):
+    """``function`` (an SX Function with dense inputs and outputs) as a Python function of numpy arrays.
+
+    Returns
+    -------
+    callable or None
+        ``g(args, outs)``: ``args[i]`` indexable by nonzero (rows of an array of samples, or
+        scalars); ``outs[i][k]`` receives nonzero ``k`` of output ``i`` (a row, broadcast from a
+        scalar where the output does not depend on the sampled inputs). None when the function
+        holds an instruction that has no numpy counterpart here.
+    """
+    source = _source(function)
+    if source is None:
+        return None
+    lines, calls = source
     namespace = {"np": np, "erf": erf, "call": _call, "calls": calls}
     exec(compile("\n".join(lines), f"<numpy {function.name()}>", "exec"), namespace)   # noqa: S102 (own source)
     return namespace["evaluate"]

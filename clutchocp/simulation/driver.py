@@ -146,12 +146,14 @@ def _outputs_on(evaluate, xs, zs, blocks_pu, t):
     return y
 
 
-def _outputs_completed(evaluate, n_out, blocks):
+def _outputs_completed(evaluate, n_out, blocks, rows=None):
     """Outputs on all samples of a segment whose grid blocks carry them already (evaluated with the
-    events, :meth:`~clutchocp.simulation.compiled.CompiledMode.native_events_outputs`): the other
-    blocks (single samples at events and input breaks) by ``evaluate``, the mode's compiled
-    outputs, in one call per run of equal inputs. Compiled code gives each sample the same value
-    whatever the samples evaluated with it."""
+    events, :meth:`~clutchocp.simulation.compiled.CompiledMode.native_events_outputs` or
+    :meth:`~clutchocp.simulation.compiled.CompiledMode.events_outputs`): the other blocks (single
+    samples at events and input breaks) by ``evaluate`` in one call per run of equal inputs; ``rows``:
+    the outputs ``evaluate`` gives, as positions in the blocks' outputs (default: all). ``evaluate``
+    must give each sample the same value whatever the samples evaluated with it: compiled code, or
+    the numpy form (:meth:`~clutchocp.simulation.compiled.ColumnFunction.on_numpy`)."""
     parts, missing = [], []
     for b in blocks:
         if b[4] is None:
@@ -161,7 +163,7 @@ def _outputs_completed(evaluate, n_out, blocks):
                 missing.append([b[3], [len(parts)]])
             parts.append(None)
         else:
-            parts.append(b[4])
+            parts.append(b[4] if rows is None else b[4][rows])
     for pu, idx in missing:
         group = [blocks[i] for i in idx]
         y = evaluate(np.concatenate([b[1] for b in group], axis=1), np.concatenate([b[2] for b in group], axis=1), pu,
@@ -177,34 +179,44 @@ def _outputs_completed(evaluate, n_out, blocks):
 class _SegmentOutputs:
     """The outputs of one segment, evaluated when first read (:class:`~clutchocp.simulation.result.LazyOutputs`).
 
-    Keeps the segment's scaled samples and its runs of equal inputs (the grid blocks too where they
-    carry outputs evaluated with the events); gives the same values as evaluating
-    every output at the end of the run: the same function on the same runs of equal inputs
-    (:func:`_outputs_on`), restricted to the outputs asked for on CasADi's virtual machine and
-    numpy (:meth:`~clutchocp.simulation.compiled.CompiledMode.outputs_subset`, the same operations);
-    compiled code and blocks that carry their outputs already (evaluated with the events) give
-    all the outputs at once.
+    Keeps the segment's scaled samples and its grid blocks, and gives the values that evaluating
+    every output at the end of the run gives: the mode's output function on each run of samples with
+    equal inputs (:func:`_outputs_on`); on CasADi's virtual machine and numpy restricted to the
+    outputs asked for (:meth:`~clutchocp.simulation.compiled.CompiledMode.outputs_subset`, the same
+    operations). Blocks that carry their outputs already (evaluated with the events) keep them where
+    the run would have been evaluated the same way: always with compiled code (each sample's values
+    whatever the others), with numpy where the run's samples take the numpy form (the other samples
+    of the run then by numpy too).
     """
 
     def __init__(self, cm, blocks, t, xs, zs, native):
         self.cm, self.t, self.xs, self.zs, self.native = cm, t, xs, zs, native
-        self.blocks = blocks if any(b[4] is not None for b in blocks) else None
-        self.runs = []
-        for b in blocks:                      # consecutive blocks with the same inputs share one call
+        self.runs = []                        # [inputs, samples, blocks] of consecutive blocks with the same inputs
+        for b in blocks:
             if self.runs and np.array_equal(self.runs[-1][0], b[3]):
                 self.runs[-1][1] += b[0].size
+                self.runs[-1][2].append(b)
             else:
-                self.runs.append([b[3], b[0].size])
+                self.runs.append([b[3], b[0].size, [b]])
 
     def __call__(self, names):
         cm = self.cm
-        if self.blocks is not None:
-            return dict(zip(cm.output_names,
-                            _outputs_completed(cm.native_outputs_on(), len(cm.output_names), self.blocks)))
         if self.native:
-            return dict(zip(cm.output_names, _outputs_on(cm.native_outputs_on(), self.xs, self.zs, self.runs, self.t)))
-        index = sorted(cm.output_index[n] for n in names)
-        y = _outputs_on(cm.outputs_subset(index), self.xs, self.zs, self.runs, self.t)
+            evaluate = cm.native_outputs_on()
+            index, rows, on_each = list(range(len(cm.output_names))), None, evaluate
+        else:
+            index = sorted(cm.output_index[n] for n in names)
+            evaluate = cm.outputs_subset(index)
+            rows, on_each = index, evaluate.on_numpy
+        parts, start = [], 0
+        for pu, count, blocks in self.runs:
+            if any(b[4] is not None for b in blocks) and (self.native or cm.outputs_on.uses_numpy(count)):
+                parts.append(_outputs_completed(on_each, len(index), blocks, rows))
+            else:
+                parts.append(_outputs_on(evaluate, self.xs[:, start:start + count], self.zs[:, start:start + count],
+                                         [(pu, count)], self.t[start:start + count]))
+            start += count
+        y = np.concatenate(parts, axis=1) if parts else np.zeros((len(index), 0))
         return {cm.output_names[i]: row for i, row in zip(index, y)}
 
 
@@ -232,6 +244,15 @@ class _Run:
             cm = self._segments[-1][0]
             self._segments[-1][1].append((np.asarray(t, float).reshape(n), np.asarray(xs, float).reshape(cm.nx, n),
                                           np.asarray(zs, float).reshape(cm.nz, n), np.asarray(pu, float), y))
+
+    def _start_outputs(self, y):
+        """Outputs ``y`` at the start of the last advance (self.t, self.xs, self.zs, self.pu) given to the
+        segment's last sample if it is that start (it is unless the advance followed a passed event)."""
+        blocks = self._segments[-1][1]
+        b = blocks[-1] if blocks else None
+        if b is not None and b[4] is None and b[0].size == 1 and b[0][0] == self.t and np.array_equal(b[1][:, 0], self.xs) \
+                and np.array_equal(b[2][:, 0], self.zs) and np.array_equal(b[3], self.pu):
+            blocks[-1] = (*b[:4], y.reshape(-1, 1))
 
     def segments(self):
         out = []
@@ -314,7 +335,16 @@ class _Run:
             inner = self.grid[(self.grid > self.t + self.tiny) & (self.grid < t_end - self.tiny)]
             times = np.append(inner, t_end)
             adv = self.path.advance(self.cm, self.t, self.xs, self.zs, self.pu, times, self.monitor)
-            self._add_block(adv.t, adv.xs, adv.zs, self.pu, adv.y)
+            if adv.y_start is not None:
+                self._start_outputs(adv.y_start)
+            if adv.y_blocks is None:
+                self._add_block(adv.t, adv.xs, adv.zs, self.pu, adv.y)
+            else:                               # some blocks carry their outputs, some not
+                start = 0
+                for size, y in adv.y_blocks:
+                    self._add_block(adv.t[start:start + size], adv.xs[:, start:start + size],
+                                    adv.zs[:, start:start + size], self.pu, y)
+                    start += size
             crossing = adv.crossing
             if crossing is None:
                 self.t, self.xs, self.zs = t_end, adv.xs[:, -1], adv.zs[:, -1]

@@ -51,7 +51,9 @@ intervals, growing by ``chunk_growth``. Mode integrations use ``native_dae`` ins
 
 The scaled event functions are evaluated on the outputs (with ``native=True``, in a mode whose
 event functions call tables, together with the mode's outputs in one compiled function:
-:meth:`~clutchocp.simulation.compiled.CompiledMode.native_events_outputs`; the outputs of the
+:meth:`~clutchocp.simulation.compiled.CompiledMode.native_events_outputs`; without, on a call
+whose samples both take the numpy form, in one numpy function:
+:meth:`~clutchocp.simulation.compiled.CompiledMode.events_outputs`; the outputs of the
 grid samples kept go back to the driver in ``Advance.y``); at the first sign change the
 crossing is located by short IDAS integrations started from the latest point known to lie
 before it: a cubic Hermite interpolant of the grid values gives the first trial time, then
@@ -331,6 +333,12 @@ class IdasPath:
 
         Returns an :class:`~clutchocp.simulation.events.Advance` with the samples strictly
         before the crossing (all of ``times`` if none) and the located crossing.
+
+        Where the events are evaluated with the outputs by numpy
+        (:meth:`~clutchocp.simulation.compiled.CompiledMode.events_outputs`), on the call that ends
+        the piece, the samples before it (the start, ``t_a``, and the earlier calls) are evaluated in
+        the same call: a numpy call costs about the same for one sample as for two thousand, so one
+        call a piece.
         """
         o = self.options
         times = np.asarray(times, float)
@@ -338,6 +346,8 @@ class IdasPath:
         self.begin_piece(cm)
         left = _Point(t_a, xs_a, zs_a, self._events(cm, xs_a, zs_a, pu, t_a)[:, 0])
         blocks = []
+        pending = [None]        # samples without outputs, to evaluate with the next merged call: None is the start
+        y_start = None
         start, size, cap, probes, horizon = 0, o.chunk, None, 0, None
         while start < times.size:
             if o.chunk is None:
@@ -364,10 +374,31 @@ class IdasPath:
                 failure = fail                  # one interval: go as far as IDAS can, look for an event there
                 targets, xs, zs = self._reach(cm, left, pu, targets[0], fail, monitor)
             y = None
-            merged = cm.native_events_outputs() if o.native and t_probe is None and failure is None else None
-            if merged is not None:          # grid samples: their outputs with the events, in one call
+            merged = None
+            if t_probe is None and failure is None:
+                # numpy: only on the call that ends the piece, with every sample before it (one call a piece)
+                merged = cm.native_events_outputs() if o.native else \
+                    cm.events_outputs(targets.size) if start + targets.size == times.size else None
+            if merged is not None and o.native:     # grid samples: their outputs with the events, in one call
                 both = merged(xs, zs, pu, targets)
                 s, y = both[:len(cm.events)], both[len(cm.events):]
+            elif merged is not None:
+                earlier = [(t_a, xs_a.reshape(cm.nx, 1), zs_a.reshape(cm.nz, 1)) if k is None else blocks[k][:3]
+                           for k in pending]
+                both = merged.on_numpy(np.concatenate([e[1] for e in earlier] + [xs], axis=1),
+                                       np.concatenate([e[2] for e in earlier] + [zs], axis=1), pu,
+                                       np.concatenate([np.atleast_1d(e[0]) for e in earlier] + [targets]))
+                first = 0
+                for k, e in zip(pending, earlier):
+                    size_k = np.size(e[0])
+                    y_k = both[len(cm.events):, first:first + size_k]
+                    if k is None:
+                        y_start = y_k[:, 0]
+                    else:
+                        blocks[k] = (*blocks[k][:3], y_k)
+                    first += size_k
+                pending = []
+                s, y = both[:len(cm.events), first:], both[len(cm.events):, first:]
             else:
                 s = self._events(cm, xs, zs, pu, targets)
             j, crossings = monitor.scan_block(left.s, s)
@@ -378,17 +409,19 @@ class IdasPath:
                 if j > 0:
                     left = _Point(targets[j - 1], xs[:, j - 1], zs[:, j - 1], s[:, j - 1])
                 crossing = self._locate(cm, pu, left, right, crossings)
-                return _advance(blocks, cm, crossing)
+                return _advance(blocks, cm, crossing, y_start)
             if failure is not None:
                 raise solver_error(self._solver(cm), failure.flag, targets[-1], cm, xs[:, -1], zs[:, -1])
             left = _Point(targets[-1], xs[:, -1], zs[:, -1], s[:, -1])
             if t_probe is not None:
                 probes += 1
                 continue
+            if y is None:
+                pending.append(len(blocks))
             blocks.append((targets, xs, zs, y))
             start += targets.size
             probes = 0
-        return _advance(blocks, cm, None)
+        return _advance(blocks, cm, None, y_start)
 
     def _plan(self, cm, left, pu, times, monitor, probes, horizon=None, first=False):
         """Grid intervals for the next call, or a probe time inside the next interval, and the
@@ -537,10 +570,13 @@ class IdasPath:
         return dict(self.counters)
 
 
-def _advance(blocks, cm, crossing):
+def _advance(blocks, cm, crossing, y_start=None):
     if not blocks:
-        return Advance(np.zeros(0), np.zeros((cm.nx, 0)), np.zeros((cm.nz, 0)), crossing)
+        return Advance(np.zeros(0), np.zeros((cm.nx, 0)), np.zeros((cm.nz, 0)), crossing, y_start=y_start)
     t = np.concatenate([b[0] for b in blocks])
-    y = np.concatenate([b[3] for b in blocks], axis=1) if all(b[3] is not None for b in blocks) else None
+    known = [b[3] is not None for b in blocks]
+    y = np.concatenate([b[3] for b in blocks], axis=1) if all(known) else None
+    y_blocks = [(b[0].size, b[3]) for b in blocks] if any(known) and not all(known) else None
     return Advance(t, np.concatenate([np.reshape(b[1], (cm.nx, b[0].size)) for b in blocks], axis=1),
-                   np.concatenate([np.reshape(b[2], (cm.nz, b[0].size)) for b in blocks], axis=1), crossing, y)
+                   np.concatenate([np.reshape(b[2], (cm.nz, b[0].size)) for b in blocks], axis=1), crossing, y,
+                   y_blocks, y_start)

@@ -22,9 +22,9 @@ def _eager(cm, seg):
     (``seg.x`` divided by its nominal values may differ from them by an ulp). Read before the outputs
     are all evaluated (the segment then lets go of its samples)."""
     kept = seg.outputs._evaluate
-    assert sum(count for _, count in kept.runs) == seg.t.size
+    assert sum(count for _, count, _ in kept.runs) == seg.t.size
     parts, start = [], 0
-    for pu, count in kept.runs:
+    for pu, count, _ in kept.runs:
         parts.append(cm.outputs_on(kept.xs[:, start:start + count], kept.zs[:, start:start + count], pu,
                                    seg.t[start:start + count]))
         start += count
@@ -93,32 +93,34 @@ def test_lazy_outputs_on_other_scenes(scene_name):
 
 
 def test_each_output_is_evaluated_once_and_the_summary_in_one_call_per_segment(driveline, monkeypatch):
+    from clutchocp.simulation import driver
+
     model, _ = driveline
     calls = []
-    original = ColumnFunction.__call__
+    original = driver._SegmentOutputs.__call__
 
-    def counted(self, xs, zs, pu, t):
-        calls.append(self.function.name())
-        return original(self, xs, zs, pu, t)
+    def counted(self, names):
+        calls.append(tuple(names))
+        return original(self, names)
 
     scene = model.scene
     options = SimulationOptions(rtol=scene.value("simulation.rtol"), atol=scene.value("simulation.atol"))
     grid = np.linspace(0.0, scene.value("simulation.t_end"), scene.value("simulation.output_points"))
     result = simulate(model.hybrid, dict(zip(model.state_names, model.initial_state)), grid,
                       mode=model.initial_mode(), options=options)
-    monkeypatch.setattr(ColumnFunction, "__call__", counted)
+    monkeypatch.setattr(driver._SegmentOutputs, "__call__", counted)
     summarize(model, result, 0.0, options, "idas")
-    output_calls = [name for name in calls if "_outputs" in name]
-    assert len(output_calls) == len(result.segments)                 # the summary read nothing it did not load
-    assert all(not name.endswith("_outputs") for name in output_calls)   # a subset, not every output
+    assert len(calls) == len(result.segments)                        # the summary read nothing it did not load
+    for seg in result.segments:                                       # and left the other outputs alone
+        assert set(seg.outputs.evaluated()) == set(summary_outputs(model)) & set(seg.outputs)
     calls.clear()
     first = result["w_in_rad_s"]
-    assert len([name for name in calls if "_outputs" in name]) == len(result.segments)
+    assert calls == [("w_in_rad_s",)] * len(result.segments)
     calls.clear()
     again = result["w_in_rad_s"]
     result["total_torque_Nm"]                                        # loaded by the summary
     result.load(summary_outputs(model))
-    assert [name for name in calls if "_outputs" in name] == []
+    assert calls == []
     assert np.array_equal(first, again)
     seg = result.segments[0]
     assert seg.outputs["w_in_rad_s"] is seg.outputs["w_in_rad_s"]      # kept, not evaluated again
@@ -172,3 +174,32 @@ def test_a_subset_takes_the_numpy_form_only_where_the_full_function_does():
         subset = ColumnFunction(ca.Function("f_outputs_1", args, [first]), like=full)
         assert np.array_equal(subset(*samples)[0], full(*samples)[0])
         assert (subset._numpy is not None) == numpy_form and (full._numpy is not None) == numpy_form
+
+
+def test_events_and_outputs_evaluated_together_change_nothing(driveline, monkeypatch):
+    """On the locked segment's grid (numpy form) the event functions are evaluated with the outputs in one
+    function: the same event values (so the same run) and the same outputs as apart."""
+    from clutchocp.simulation.compiled import CompiledMode
+
+    model, _ = driveline
+    compiled = model.hybrid.compiled()
+    locked, slipping = compiled["pressing_locked"], compiled["pressing_slip_forward"]
+    together = simulate_engagement(model.scene, model=model)
+    seg = next(s for s in together.result.segments if s.mode == "pressing_locked")
+    # used on this run, the samples before the first call's (the segment's start) in the same call
+    assert all(b[4] is not None for run in seg.outputs._evaluate.runs for b in run[2])
+    merged = locked.events_outputs(seg.t.size)
+    assert merged is not None and slipping.events_outputs(200) is None                   # slipping: CasADi's map
+    kept = seg.outputs._evaluate
+    pu = kept.runs[0][0]
+    both = merged.on_numpy(kept.xs, kept.zs, pu, seg.t)
+    n_events = len(locked.events)
+    assert np.array_equal(both[:n_events], locked.events_on(kept.xs, kept.zs, pu, seg.t), equal_nan=True)
+    assert np.array_equal(both[n_events:], locked.outputs_on(kept.xs, kept.zs, pu, seg.t), equal_nan=True)
+    monkeypatch.setattr(CompiledMode, "events_outputs", lambda self, n: None)
+    apart = simulate_engagement(model.scene, model=EngagementModel(model.scene))
+    assert together.summary["solver"]["statistics"]["n_steps"] == apart.summary["solver"]["statistics"]["n_steps"]
+    a, b = together.series(), apart.series()
+    for name in a:
+        if name != "mode":
+            assert np.array_equal(a[name], b[name], equal_nan=True), name

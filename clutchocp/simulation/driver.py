@@ -250,8 +250,9 @@ class _Run:
         segment's last sample if it is that start (it is unless the advance followed a passed event)."""
         blocks = self._segments[-1][1]
         b = blocks[-1] if blocks else None
-        if b is not None and b[4] is None and b[0].size == 1 and b[0][0] == self.t and np.array_equal(b[1][:, 0], self.xs) \
-                and np.array_equal(b[2][:, 0], self.zs) and np.array_equal(b[3], self.pu):
+        if b is not None and b[4] is None and b[0].size == 1 and b[0][0] == self.t \
+                and np.array_equal(b[1][:, 0], self.xs) and np.array_equal(b[2][:, 0], self.zs) \
+                and np.array_equal(b[3], self.pu):
             blocks[-1] = (*b[:4], y.reshape(-1, 1))
 
     def segments(self):

@@ -159,8 +159,7 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
             return feedforward[1], feedforward[2]
         same = design_scene is scene
         if reserve > 0:
-            top = pressure_limits(design_scene, spec)[1] - reserve
-            design_scene = design_scene.with_overrides({"actuation.max_pressure": top})
+            design_scene = with_pressure_limit(design_scene, pressure_limits(design_scene, spec)[1] - reserve)
         problem = ocp if same and reserve == 0 else EngagementOCP(design_scene, intervals=intervals)
         if same and not margin and reserve == 0:
             return opt.command_times, opt.command
@@ -177,6 +176,16 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         facts["closed_loop"] = _closed_loop_facts(scene, spec, schedule, feedforward[0])
     strategies = [s for s in strategies if s.name in chosen or s.notes.get("centre_only")]
     return strategies, facts
+
+
+def with_pressure_limit(scene, limit):
+    """The scene with ``actuation.max_pressure`` lowered to ``limit`` [Pa], its own step pressure
+    (``actuation.pressure``, the optimisation's first guess) lowered with it where it was above."""
+    lowered = {"actuation.max_pressure": limit}
+    step = scene.get("actuation.pressure")
+    if isinstance(step, (int, float)) and step > limit:
+        lowered["actuation.pressure"] = limit
+    return scene.with_overrides(lowered)
 
 
 def _closed_loop_strategy(spec, schedule, ff_label, feedforward):

@@ -110,14 +110,14 @@ class EventMonitor:
         if not self.specs:
             return None, []
         S = np.asarray(S, float).reshape(len(self.specs), -1)
-        prev = np.column_stack([np.asarray(s0, float).reshape(-1, 1), S[:, :-1]])
+        V = np.column_stack([np.asarray(s0, float).reshape(-1, 1), S])     # s0, then the samples
         j = 0
         while j < S.shape[1]:
-            k = self._first_change(prev[:, j:], S[:, j:])
+            k = self._first_change(V[:, j:-1], V[:, j + 1:])
             if k is None:
                 return None, []
             j += k
-            crossings, new_state = self.scan(prev[:, j], S[:, j])
+            crossings, new_state = self.scan(V[:, j], S[:, j])
             if crossings:
                 return j, crossings
             self.commit(new_state)
@@ -126,18 +126,27 @@ class EventMonitor:
 
     def _first_change(self, A, B):
         """Index of the first step (A[:, k] -> B[:, k]) at which :meth:`scan` would report a
-        crossing or change an arming state (None if there is none)."""
-        first = None
+        crossing or change an arming state (None if there is none).
+
+        The events of one arming state and direction are tested together, as rows of one array
+        (usually every event of the mode: all armed, the same direction)."""
+        groups = {}
         for i, spec in enumerate(self.specs):
-            d, a, b, st = spec.direction, A[i], B[i], self.state[i]
-            if st == ARMED:
+            groups.setdefault((self.state[i], spec.direction), []).append(i)
+        first = None
+        for (st, d), rows in groups.items():
+            a, b = (A, B) if len(rows) == len(self.specs) else (A[rows], B[rows])
+            if st == ARMED and d in (1, -1):      # d a < 0 <= d b without the products (the same for NaN)
+                hit = (a < 0) & (b >= 0) if d == 1 else (a > 0) & (b <= 0)
+            elif st == ARMED:
                 hit = ((a > 0) & (b <= 0)) | ((a < 0) & (b >= 0)) if d == 0 else (d * a < 0) & (d * b >= 0)
             else:
                 pre = np.abs(b) > self.band if d == 0 else d * b < -self.band
                 hit = pre | (d * b > self.band) if (st == ENTRY and d != 0) else pre
-            found = np.flatnonzero(hit)
-            if found.size and (first is None or found[0] < first):
-                first = int(found[0])
+            any_row = hit.any(axis=0)
+            k = int(any_row.argmax()) if any_row.size else 0
+            if any_row.size and any_row[k] and (first is None or k < first):
+                first = k
         return first
 
     def scipy_events(self):

@@ -71,6 +71,7 @@ normalised-time ODE for modes without algebraic variables, and enforces
 ``SimulationOptions.max_wall_time`` before every call.
 """
 
+import functools
 import math
 import time
 import warnings
@@ -132,6 +133,18 @@ def first_positive_root(a, b, c):
     roots = [q / q2, a / q if q != 0 else math.inf]
     positive = [r for r in roots if r > 0]
     return min(positive) if positive else math.inf
+
+
+@functools.lru_cache(maxsize=4)
+def _hermite_basis(n):
+    """The ``n`` equally spaced points ``th`` of [0, 1] and the cubic Hermite basis functions there
+    (h00, h10, h01, h11), computed once per ``n`` (read-only arrays)."""
+    th = np.linspace(0.0, 1.0, n)
+    h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
+    h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
+    for a in (th, h00, h10, h01, h11):
+        a.flags.writeable = False
+    return th, h00, h10, h01, h11
 
 
 def _uniform_count(t0, times, tol=1e-8):
@@ -551,9 +564,7 @@ class IdasPath:
         h = tb - ta
         da = cm.at("ode", xa, za, pu, ta)
         db = cm.at("ode", xb, zb, pu, tb)
-        th = np.linspace(0.0, 1.0, n)
-        h00, h10 = 2 * th**3 - 3 * th**2 + 1, th**3 - 2 * th**2 + th
-        h01, h11 = -2 * th**3 + 3 * th**2, th**3 - th**2
+        th, h00, h10, h01, h11 = _hermite_basis(n)
         x = np.outer(xa, h00) + np.outer(h * da, h10) + np.outer(xb, h01) + np.outer(h * db, h11)
         z = np.outer(za, 1 - th) + np.outer(zb, th)
         phi = self._events(cm, x, z, pu, ta + th * h)[i] - offset

@@ -126,8 +126,10 @@ class SimulationResult:
     @classmethod
     def from_segments(cls, segments, events, stats):
         t = np.concatenate([s.t for s in segments]) if segments else np.zeros(0)
-        mode = np.concatenate([np.full(s.t.size, s.mode, dtype=object) for s in segments]) \
-            if segments else np.zeros(0, dtype=object)
+        labels = np.empty(len(segments), dtype=object)     # one mode label a segment, repeated on its samples
+        for i, s in enumerate(segments):
+            labels[i] = s.mode
+        mode = np.repeat(labels, [s.t.size for s in segments])
         return cls(t=t, mode=mode, segments=segments, events=events, stats=stats)
 
     def load(self, names):

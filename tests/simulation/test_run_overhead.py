@@ -360,3 +360,38 @@ def test_one_sample_calls_through_bound_buffers_equal_casadi_calls():
             column(np.zeros((2, 5)), np.zeros((0, 5)), p, np.zeros(5))
             assert 1 not in column._maps
     assert all(np.array_equal(got[:, 0], reference) for got, reference in kept)   # earlier results untouched
+
+
+def _scan_one_by_one(monitor, s0, S):
+    """The reference for ``EventMonitor.scan_block``: :meth:`scan` on every step, committed as passed."""
+    prev = s0
+    for j in range(S.shape[1]):
+        crossings, new_state = monitor.scan(prev, S[:, j])
+        if crossings:
+            return j, crossings
+        monitor.commit(new_state)
+        prev = S[:, j]
+    return None, []
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_block_scan_of_event_values_equals_the_scan_sample_by_sample(seed):
+    """Event values near zero and near the band (signed zeros, NaN, values on the band), every arming
+    state and direction mixed: the block scan finds the step, the crossings and the arming the
+    step-by-step scan finds."""
+    from clutchocp.simulation.compiled import EventSpec
+    from clutchocp.simulation.events import ARMED, ENTRY, PASSED, EventMonitor
+
+    rng = np.random.default_rng(seed)
+    band = 1e-5
+    n_events = int(rng.integers(1, 7))
+    specs = [EventSpec(i, f"e{i}", int(rng.choice([-1, 0, 1])), "m", i) for i in range(n_events)]
+    choices = np.array([0.0, -0.0, band, -band, 2 * band, -2 * band, 0.5 * band, np.nan, 1.0, -1.0])
+    S = rng.choice(choices, size=(n_events, int(rng.integers(1, 40)))) * rng.choice([1.0, 1.5], size=(n_events, 1))
+    S[:, : S.shape[1] // 2] = np.abs(S[:, : S.shape[1] // 2]) * rng.choice([-1.0, 1.0], size=(n_events, 1))
+    s0 = rng.choice(choices, size=n_events)
+    states = [str(rng.choice([ARMED, ENTRY, PASSED])) for _ in range(n_events)]
+    block, reference = EventMonitor(specs, band), EventMonitor(specs, band)
+    block.state, reference.state = list(states), list(states)
+    assert block.scan_block(s0, S) == _scan_one_by_one(reference, s0, S)
+    assert block.state == reference.state

@@ -340,7 +340,7 @@ class _Run:
                 self._start_outputs(adv.y_start)
             if adv.y_blocks is None:
                 self._add_block(adv.t, adv.xs, adv.zs, self.pu, adv.y)
-            else:                               # some blocks carry their outputs, some not
+            else:                               # block by block, each with its outputs or without
                 start = 0
                 for size, y in adv.y_blocks:
                     self._add_block(adv.t[start:start + size], adv.xs[:, start:start + size],

@@ -47,7 +47,7 @@ class Advance:
     zs: np.ndarray      # (nz, n)
     crossing: Crossing | None = None
     y: np.ndarray | None = None     # (n_outputs, n): the mode's outputs on the samples, if already evaluated
-    y_blocks: list | None = None    # where only some samples have them: [(samples, outputs or None)] in order
+    y_blocks: list | None = None    # or block by block: [(samples, outputs or None)] in order
     y_start: np.ndarray | None = None   # (n_outputs,): the outputs at the start of the call, if evaluated
 
 

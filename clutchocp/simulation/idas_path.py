@@ -585,9 +585,10 @@ def _advance(blocks, cm, crossing, y_start=None):
     if not blocks:
         return Advance(np.zeros(0), np.zeros((cm.nx, 0)), np.zeros((cm.nz, 0)), crossing, y_start=y_start)
     t = np.concatenate([b[0] for b in blocks])
-    known = [b[3] is not None for b in blocks]
-    y = np.concatenate([b[3] for b in blocks], axis=1) if all(known) else None
-    y_blocks = [(b[0].size, b[3]) for b in blocks] if any(known) and not all(known) else None
+    # outputs of one block as they are; of several, block by block (the driver keeps blocks: no copy)
+    y = blocks[0][3] if len(blocks) == 1 else None
+    y_blocks = [(b[0].size, b[3]) for b in blocks] if len(blocks) > 1 and any(b[3] is not None for b in blocks) \
+        else None
     return Advance(t, np.concatenate([np.reshape(b[1], (cm.nx, b[0].size)) for b in blocks], axis=1),
                    np.concatenate([np.reshape(b[2], (cm.nz, b[0].size)) for b in blocks], axis=1), crossing, y,
                    y_blocks, y_start)

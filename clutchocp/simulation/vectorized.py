@@ -115,6 +115,7 @@ class PiecewiseCubic:
         points = grid[:-1, None] + u[None, :] * np.diff(grid)[:, None]
         values = np.array(function(ca.DM(points.ravel()).T), dtype=float).reshape(points.shape)
         self.coefficients = np.ascontiguousarray((values @ self._FIT.T).T)   # (4, intervals): c0 + c1 u + ... c3 u^3
+        self._left, self._width = grid[:-1], grid[1:] - grid[:-1]      # each interval's start and width
         check = grid[:-1, None] + np.array([0.25, 0.5, 0.75])[None, :] * np.diff(grid)[:, None]
         exact = np.array(function(ca.DM(check.ravel()).T), dtype=float).ravel()
         scale = max(1.0, float(np.max(np.abs(values))))
@@ -126,12 +127,14 @@ class PiecewiseCubic:
         x = np.asarray(x, float)
         grid = self.grid
         if self._inverse_step is not None:      # uniform grid: the interval by division (no search)
-            i = np.nan_to_num((x - grid[0]) * self._inverse_step, nan=0.0, posinf=0.0, neginf=0.0).astype(np.intp)
+            r = (x - grid[0]) * self._inverse_step
+            r[~np.isfinite(r)] = 0.0            # NaN and +-inf: interval 0 (evaluated by CasADi below)
+            i = r.astype(np.intp)
         else:
             i = np.searchsorted(grid, x, side="right") - 1
-        np.clip(i, 0, grid.size - 2, out=i)
-        u = (x - grid[i]) / (grid[i + 1] - grid[i])
-        c0, c1, c2, c3 = (row[i] for row in self.coefficients)
+        np.minimum(np.maximum(i, 0, out=i), grid.size - 2, out=i)     # clipped to the intervals
+        u = (x - self._left[i]) / self._width[i]
+        c0, c1, c2, c3 = self.coefficients.take(i, axis=1)
         y = c0 + u * (c1 + u * (c2 + u * c3))
         outside = ~((x >= grid[0]) & (x <= grid[-1]))
         if outside.any():
@@ -176,13 +179,15 @@ def _call(callee, *args):
     a registered table (:func:`register_table`) with numpy, anything else through a map over the
     samples called with the buffer interface (numpy in and out)."""
     shape = np.broadcast(*args).shape
-    n = int(np.prod(shape)) if shape else 1
+    n = math.prod(shape)
     if n == 0:
         return np.zeros(shape)
     _take_declared()
     table = _TABLES.get(hash(callee))
     if table is not None and len(args) == 1:
-        result = table(np.ravel(np.broadcast_to(args[0], shape)))
+        x = args[0]
+        result = table(np.ravel(x) if isinstance(x, np.ndarray) and x.shape == shape else
+                       np.ravel(np.broadcast_to(x, shape)))
     else:
         result = _casadi_call(callee, *(np.ravel(np.broadcast_to(a, shape)) for a in args))
     return result.reshape(shape) if shape else float(result[0])

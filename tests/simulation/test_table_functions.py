@@ -30,6 +30,29 @@ def test_piecewise_cubic_equals_the_interpolant_to_rounding(kind, uniform):
     assert np.array_equal(got[outside & finite], exact[outside & finite])
 
 
+@pytest.mark.parametrize("uniform", [True, False])
+def test_piecewise_cubic_is_its_interval_cubics_sample_by_sample(uniform):
+    """Within the grid each value is, bit for bit, its interval's cubic by Horner's rule on Python
+    floats (the interval found by bisection, the local variable from that interval's ends)."""
+    import bisect
+
+    grid = np.linspace(-2.0, 3.0, 41) if uniform else np.cumsum(np.r_[-2.0, np.linspace(0.05, 0.3, 30)])
+    f = ca.interpolant(f"t_scalar_{uniform}", "bspline", [grid.tolist()], (np.cos(grid) + 0.2 * grid**2).tolist())
+    table = PiecewiseCubic(f, grid)
+    rng = np.random.default_rng(3)
+    x = np.concatenate([rng.uniform(grid[0], grid[-1], 3000), grid])
+    got = table(x)
+    g = grid.tolist()
+    for value, xi in zip(got.tolist(), x.tolist()):
+        if uniform:
+            i = min(max(int((xi - g[0]) * table._inverse_step), 0), len(g) - 2)
+        else:
+            i = min(max(bisect.bisect_right(g, xi) - 1, 0), len(g) - 2)
+        u = (xi - g[i]) / (g[i + 1] - g[i])
+        c0, c1, c2, c3 = (float(table.coefficients[k, i]) for k in range(4))
+        assert value == c0 + u * (c1 + u * (c2 + u * c3))
+
+
 def test_a_grid_that_misses_the_knots_is_refused():
     grid = np.linspace(0.0, 1.0, 21)
     f = ca.interpolant("t_knots", "bspline", [grid.tolist()], np.exp(3 * grid).tolist())

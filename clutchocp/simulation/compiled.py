@@ -158,8 +158,8 @@ class ColumnFunction:
     def _single(self, xs, zs, pu, t):
         """One sample on the 1-sample map, through arrays bound to its buffer once (a run makes
         ~20 such calls: guards, resets, event values and slopes at one time, outputs at events)."""
-        entry = self._map(1)
-        if self._one is None or self._one[0] is not entry:
+        if self._one is None:                     # bound once: the map stays alive with it
+            entry = self._map(1)
             _, buf, _ = entry
             args = [np.zeros(max(size, 1)) for size in self.sizes]     # an empty input gets a dummy
             out = np.zeros(max(self.n_out, 1))
@@ -171,9 +171,9 @@ class ColumnFunction:
         for a, v, size in zip(args, (xs, zs, pu, t), self.sizes):
             if size:
                 a[:] = np.ravel(v)
-        out[:] = 0.0                              # CasADi leaves outputs that are constant zeros unwritten
+        out.fill(0.0)                             # CasADi leaves outputs that are constant zeros unwritten
         entry[2]()
-        return out[:self.n_out].reshape(self.n_out, 1).copy()
+        return out[:self.n_out, None].copy()
 
     def _looped(self, xs, zs, pu, t, n):
         """The compiled loop over the ``n`` samples (sample-major copies in, sample-major out)."""

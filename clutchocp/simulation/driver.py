@@ -262,9 +262,8 @@ class _Run:
             xs = np.concatenate([b[1] for b in blocks], axis=1) if blocks else np.zeros((cm.nx, 0))
             zs = np.concatenate([b[2] for b in blocks], axis=1) if blocks else np.zeros((cm.nz, 0))
             outputs = LazyOutputs(cm.output_names, _SegmentOutputs(cm, blocks, t, xs, zs, self.opts.native))
-            out.append(Segment(cm.name, t,
-                               {k: xs[j] * cm.x_nominal[j] for j, k in enumerate(cm.x_names)},
-                               {k: zs[j] * cm.z_nominal[j] for j, k in enumerate(cm.z_names)}, outputs))
+            x, z = xs * cm.x_nominal[:, None], zs * cm.z_nominal[:, None]     # unscaled, row by row
+            out.append(Segment(cm.name, t, dict(zip(cm.x_names, x)), dict(zip(cm.z_names, z)), outputs))
         return out
 
     # ------------------------------------------------------------- mode entry and switches

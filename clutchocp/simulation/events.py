@@ -110,6 +110,12 @@ class EventMonitor:
         if not self.specs:
             return None, []
         S = np.asarray(S, float).reshape(len(self.specs), -1)
+        if S.shape[1] == 1:                         # one sample: the scan itself
+            crossings, new_state = self.scan(np.asarray(s0, float).ravel(), S[:, 0])
+            if crossings:
+                return 0, crossings
+            self.commit(new_state)
+            return None, []
         V = np.column_stack([np.asarray(s0, float).reshape(-1, 1), S])     # s0, then the samples
         j = 0
         while j < S.shape[1]:

@@ -150,10 +150,23 @@ def _hermite_basis(n):
 def _uniform_count(t0, times, tol=1e-8):
     """How many leading ``times`` are equally spaced from ``t0`` (spacing times[0] - t0)."""
     step = times[0] - t0
-    k = np.arange(1, times.size + 1)
+    k = _counting(times.size)
     ok = np.abs((times - t0) - k * step) <= tol * step
-    bad = np.flatnonzero(~ok)
-    return int(bad[0]) if bad.size else int(times.size)
+    first_bad = int(ok.argmin())
+    return int(times.size) if ok[first_bad] else first_bad
+
+
+def _counting(n):
+    """1.0, 2.0, ..., n as a read-only float array (a view of one kept array, grown when too short)."""
+    count = _COUNT[0]
+    if count.size < n:
+        count = np.arange(1, max(n, 2 * count.size) + 1, dtype=float)
+        count.flags.writeable = False
+        _COUNT[0] = count
+    return count[:n]
+
+
+_COUNT = [np.zeros(0)]
 
 
 class _Integrator:
@@ -255,7 +268,7 @@ class IdasPath:
     def _integrator(self, cm, taus, span, scheme):
         """The cached integrator (``scheme``) of ``cm`` with outputs at normalised times ``taus``."""
         n = len(taus)
-        uniform = float(np.max(np.abs(taus - np.arange(1, n + 1) / n))) <= 1e-9
+        uniform = float(np.max(np.abs(taus - _counting(n) / n))) <= 1e-9
         pattern = n if uniform else tuple(np.round(taus, 12))
         key = (self._options_key[scheme], pattern, span if self.options.max_step is not None else None)
         cache = cm.integrators.setdefault(scheme, OrderedDict())
@@ -484,7 +497,7 @@ class IdasPath:
         if not cm.events:
             return math.inf, False
         unknown = False
-        slopes = cm.event_slopes()(left.xs, left.zs, pu, left.t).reshape(3, len(cm.events)).T
+        slopes = cm.event_slopes()(left.xs, left.zs, pu, left.t).reshape(3, len(cm.events)).T.tolist()   # floats
         best = math.inf
         for i, spec in enumerate(cm.events):
             state = monitor.state[i]

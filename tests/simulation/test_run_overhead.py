@@ -391,7 +391,8 @@ def test_block_scan_of_event_values_equals_the_scan_sample_by_sample(seed):
     S[:, : S.shape[1] // 2] = np.abs(S[:, : S.shape[1] // 2]) * rng.choice([-1.0, 1.0], size=(n_events, 1))
     s0 = rng.choice(choices, size=n_events)
     states = [str(rng.choice([ARMED, ENTRY, PASSED])) for _ in range(n_events)]
-    block, reference = EventMonitor(specs, band), EventMonitor(specs, band)
-    block.state, reference.state = list(states), list(states)
-    assert block.scan_block(s0, S) == _scan_one_by_one(reference, s0, S)
-    assert block.state == reference.state
+    for samples in (S, S[:, :1]):               # a block, and the single sample
+        block, reference = EventMonitor(specs, band), EventMonitor(specs, band)
+        block.state, reference.state = list(states), list(states)
+        assert block.scan_block(s0, samples) == _scan_one_by_one(reference, s0, samples)
+        assert block.state == reference.state

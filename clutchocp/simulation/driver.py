@@ -133,6 +133,12 @@ def _inputs(model, p, u, grid):
     return _Inputs(fixed, schedules, breaks)
 
 
+def _same_inputs(a, b):
+    """Whether two parameter + input vectors are equal (the same array, as a piece's samples share it,
+    or equal values; the values are finite)."""
+    return a is b or np.array_equal(a, b)
+
+
 def _outputs_on(evaluate, xs, zs, blocks_pu, t):
     """Outputs (``evaluate``: a mode's ColumnFunction) on all samples of a segment, one call per run
     of equal inputs."""
@@ -157,7 +163,7 @@ def _outputs_completed(evaluate, n_out, blocks, rows=None):
     parts, missing = [], []
     for b in blocks:
         if b[4] is None:
-            if missing and np.array_equal(missing[-1][0], b[3]):
+            if missing and _same_inputs(missing[-1][0], b[3]):
                 missing[-1][1].append(len(parts))
             else:
                 missing.append([b[3], [len(parts)]])
@@ -193,7 +199,7 @@ class _SegmentOutputs:
         self.cm, self.t, self.xs, self.zs, self.native = cm, t, xs, zs, native
         self.runs = []                        # [inputs, samples, blocks] of consecutive blocks with the same inputs
         for b in blocks:
-            if self.runs and np.array_equal(self.runs[-1][0], b[3]):
+            if self.runs and _same_inputs(self.runs[-1][0], b[3]):
                 self.runs[-1][1] += b[0].size
                 self.runs[-1][2].append(b)
             else:
@@ -252,7 +258,7 @@ class _Run:
         b = blocks[-1] if blocks else None
         if b is not None and b[4] is None and b[0].size == 1 and b[0][0] == self.t \
                 and np.array_equal(b[1][:, 0], self.xs) and np.array_equal(b[2][:, 0], self.zs) \
-                and np.array_equal(b[3], self.pu):
+                and _same_inputs(b[3], self.pu):
             blocks[-1] = (*b[:4], y.reshape(-1, 1))
 
     def segments(self):
@@ -332,7 +338,9 @@ class _Run:
                 raise solver_error(self.path.name, "wall_time", self.t, self.cm, self.xs, self.zs,
                                    detail=f" ({self.opts.max_wall_time:g} s)")
             t_end = next((b for b in self.inputs.breaks if b > self.t + self.tiny), t_final)
-            inner = self.grid[(self.grid > self.t + self.tiny) & (self.grid < t_end - self.tiny)]
+            # grid points in (t + tiny, t_end - tiny): the grid is strictly increasing
+            inner = self.grid[np.searchsorted(self.grid, self.t + self.tiny, side="right"):
+                              np.searchsorted(self.grid, t_end - self.tiny, side="left")]
             times = np.append(inner, t_end)
             adv = self.path.advance(self.cm, self.t, self.xs, self.zs, self.pu, times, self.monitor)
             if adv.y_start is not None:

@@ -186,16 +186,14 @@ def check_contact_capacity(scene, *, max_pressure=None):
     A scene that passed at its own pressures passes again without computing (a table profile,
     read from its file at each check, is always checked).
     """
+    if scene.kind != "engagement" or scene.variant("contact") not in _LAWS:
+        return None                                     # no contact law: no capacity (contact_capacity)
     table = scene.variant("actuation") == "table"
     remember = max_pressure is None and not table
     if remember and scene in _PASSED:
         return _PASSED[scene]
-    film = FilmLaw(scene) if scene.kind == "engagement" and scene.variant("contact") in _LAWS else None
+    film = FilmLaw(scene)
     capacity = contact_capacity(scene, film)
-    if capacity is None:
-        if remember:
-            _PASSED[scene] = None
-        return None
     source = ("actuation.max_pressure" if max_pressure is not None
               else "the pressures of actuation.file" if table else "actuation.pressure")
     oil = (0.0, float(max_pressure)) if max_pressure is not None else run_oil_pressures(scene)

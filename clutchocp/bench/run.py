@@ -16,7 +16,10 @@
   the integrator floor (``floor_speedup_vs_radau``, ``floor_speedup_vs_lsoda``: the integrators
   alone with the event times known, :mod:`clutchocp.bench.floor`) and the share of it whole runs
   keep (``whole_over_floor_vs_radau``, ``whole_over_floor_vs_lsoda``: ``speedup_vs_<peer>`` /
-  ``floor_speedup_vs_<peer>``; 1 when a whole run costs over the floor what the peer's does);
+  ``floor_speedup_vs_<peer>``; 1 when a whole run costs over the floor what the peer's does), and
+  the most a whole run could keep with its integrator calls as they are, spending no time outside
+  them (``whole_over_floor_bound_vs_radau``, ``whole_over_floor_bound_vs_lsoda``,
+  :func:`whole_over_floor_bound`);
   ``idas_slower``: every scene, peer and matched error level at which a peer was faster than IDAS
   (a measured fact, not a target); ``single_run_s``: one warm bao2020 engagement at its settings;
 * ``engagement_integrator_floor.csv`` -- the floor of every method and tolerance (also drawn,
@@ -102,6 +105,7 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
                                                                  repeats=settings["scaling_repeats"], progress=bar)
         per_scene[scene.name] = {**_scene_summary(res, profile, scaling_results[scene.name], speed_rows), **low}
         per_scene[scene.name].update(whole_over_floor(per_scene[scene.name]))
+        per_scene[scene.name].update(whole_over_floor_bound(res["rows"], per_scene[scene.name]))
 
     files.append(workprecision.write_rows(out / "engagement_work_precision.csv", [r for res in results for r in res["rows"]]))
     files.append(workprecision.write_rows(out / "engagement_integrator_floor.csv", [r for rows in floors.values() for r in rows],
@@ -174,6 +178,42 @@ def whole_over_floor(entry, peers=floor.PEERS):
     return out
 
 
+def whole_over_floor_bound(rows, entry, peers=floor.PEERS, levels=workprecision.ERROR_LEVELS):
+    """The whole / floor a run would reach if it spent no time outside its integrator calls.
+
+    Per peer: the peer's whole-run time over IDAS's time inside its integrator calls
+    (``integration_time_s``) at matched error, averaged over the error levels as
+    ``speedup_vs_<peer>`` is (:func:`~clutchocp.bench.workprecision.headline`), divided by
+    ``floor_speedup_vs_<peer>``. The calls of a whole run start and stop where its events are found
+    (it cannot know an event before integrating past it), so they cost more than the floor's one
+    call per mode piece; this bound is what whole / floor could reach by cutting the output grid,
+    the summary and the other work between the calls, with the calls unchanged.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The work-precision rows of one scene (``method``, ``status``, ``error``, ``wall_time_s``,
+        ``integration_time_s`` [s]).
+    entry : dict
+        The scene's summary entry, with ``floor_speedup_vs_<peer>``.
+    peers : sequence of str
+        The floor's peers.
+    levels : sequence of float
+        The matched error levels (those of ``speedup_vs_<peer>``).
+
+    Returns
+    -------
+    dict
+        ``{whole_over_floor_bound_vs_<peer>: float or None}`` (None where a ratio is missing).
+    """
+    ratios = workprecision.speedups(rows, peers=peers, levels=levels, key="wall_time_s", idas_key="integration_time_s")
+    out = {}
+    for peer, by_level in ratios.items():
+        bound, low = workprecision.headline(by_level)[0], entry.get(f"floor_speedup_vs_{peer.lower()}")
+        out[f"whole_over_floor_bound_vs_{peer.lower()}"] = bound / low if bound is not None and low else None
+    return out
+
+
 def idas_slower(per_scene):
     """Where a scipy method was faster than IDAS at matched error: [{scene, peer, error_level, time_ratio}].
 
@@ -234,7 +274,9 @@ def format_summary(summary):
         lines.append(f"    integrator floor (event times known, one call per mode piece): IDAS vs Radau "
                      f"{num(e.get('floor_speedup_vs_radau'))}x, LSODA {num(e.get('floor_speedup_vs_lsoda'))}x; "
                      f"whole / floor: Radau {num(e.get('whole_over_floor_vs_radau'))}, "
-                     f"LSODA {num(e.get('whole_over_floor_vs_lsoda'))}")
+                     f"LSODA {num(e.get('whole_over_floor_vs_lsoda'))} (bound with no time outside the "
+                     f"integrator calls: Radau {num(e.get('whole_over_floor_bound_vs_radau'))}, "
+                     f"LSODA {num(e.get('whole_over_floor_bound_vs_lsoda'))})")
         lines.append(f"    run time ~ pairs^{e['scaling_exponent_pairs']:.2f}; stiffness ratio up to "
                      f"{num(stiff['max_stiffness_ratio'], '{:.3g}')}, fastest time constant "
                      f"{num(stiff['min_time_constant_s'], '{:.3g}')} s")

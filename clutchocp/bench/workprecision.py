@@ -252,15 +252,18 @@ def points_of(rows, method, key="wall_time_s"):
     return [(r["error"], r[key]) for r in rows if r["method"] == method and r.get("status") == "ok"]
 
 
-def speedups(rows, peers=PEERS, levels=ERROR_LEVELS, key="wall_time_s"):
+def speedups(rows, peers=PEERS, levels=ERROR_LEVELS, key="wall_time_s", idas_key=None):
     """Time ratio peer / IDAS at each matched error level (None where either sweep does not reach it).
+
+    ``key`` is the row's time [s] both sides are read at; ``idas_key`` (default ``key``) the one
+    IDAS's side is read at, e.g. ``"integration_time_s"`` against the peers' ``"wall_time_s"``.
 
     Returns
     -------
     dict
         ``{peer: {level: ratio or None}}``.
     """
-    idas = points_of(rows, "idas", key)
+    idas = points_of(rows, "idas", idas_key or key)
     out = {}
     for peer in peers:
         other = points_of(rows, peer, key)

@@ -22,6 +22,7 @@ the load of film 1 when nothing else carries it (no spline friction, no inlet-pr
 only lower the load, so the check is on the safe side).
 """
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,9 @@ from .piston import piston_part
 
 _LAWS = {"greenwood_tripp": "Greenwood-Tripp", "zhang_gw": "Zhang's Greenwood-Williamson contact (E delta^2)"}
 _REMEDY = "raise roughness.sigma_* / contact.E_equiv / roughness.asperity_density"
+# scene -> the outcome of its passed check at its own pressures: a Scene does not change, and a bench
+# or sweep runs the same scene hundreds of times (~20-70 us a check, the contact law at zero gap)
+_PASSED = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True)
@@ -92,7 +96,7 @@ def zero_gap_pressure(film):
     return float(film.contact_force(0.0)) / film.area
 
 
-def contact_capacity(scene):
+def contact_capacity(scene, film=None):
     """The contact's capacity at zero gap (:class:`ContactCapacity`), or None for ``contact.model = "none"``
     (and for a scene that is not an engagement: its run refuses it).
 
@@ -100,11 +104,13 @@ def contact_capacity(scene):
     ----------
     scene : clutchocp.scene.Scene
         An engagement scene.
+    film : clutchocp.engagement.films.FilmLaw, optional
+        The scene's film law, if already built.
     """
     model = scene.variant("contact") if scene.kind == "engagement" else ""
     if model not in _LAWS:
         return None
-    film = FilmLaw(scene)
+    film = film if film is not None else FilmLaw(scene)
     pressure = zero_gap_pressure(film)
     n_beta_sigma = film.n_a * film.beta * film.sigma
     law = _LAWS[model]
@@ -126,19 +132,20 @@ def run_oil_pressures(scene):
     return (scene.value("actuation.initial_pressure"), scene.value("actuation.pressure"))
 
 
-def pack_pressure(scene, oil_pressures):
+def pack_pressure(scene, oil_pressures, film=None):
     """The largest nominal pressure on film 1 with every film closed, over ``oil_pressures`` [Pa].
 
     The pack force is the drive of the scene's piston part at full stroke (free travel plus every
     initial gap closed: x0 = travel + n H0; springs at their most compressed for a pressure-applied
     piston, least for a spring-applied one), or p A without a piston; it is linear in the oil
-    pressure, so its largest value over a profile is at one of the profile's extremes.
+    pressure, so its largest value over a profile is at one of the profile's extremes. ``film``:
+    the scene's :class:`~clutchocp.engagement.films.FilmLaw`, if already built.
 
     Returns
     -------
     PackPressure
     """
-    film_area = FilmLaw(scene).area
+    film_area = (film if film is not None else FilmLaw(scene)).area
     part = piston_part(scene, scene.get("actuation.area") or film_area)
     stroke = part.travel + scene.value("plates.n_interfaces") * scene.value("pack.initial_gap")
 
@@ -173,15 +180,27 @@ def check_contact_capacity(scene, *, max_pressure=None):
     ------
     PhysicalRangeError
         One line naming both pressures, the contact data and what to change.
+
+    Notes
+    -----
+    A scene that passed at its own pressures passes again without computing (a table profile,
+    read from its file at each check, is always checked).
     """
-    capacity = contact_capacity(scene)
-    if capacity is None:
-        return None
+    if scene.kind != "engagement" or scene.variant("contact") not in _LAWS:
+        return None                                     # no contact law: no capacity (contact_capacity)
+    table = scene.variant("actuation") == "table"
+    remember = max_pressure is None and not table
+    if remember and scene in _PASSED:
+        return _PASSED[scene]
+    film = FilmLaw(scene)
+    capacity = contact_capacity(scene, film)
     source = ("actuation.max_pressure" if max_pressure is not None
-              else "the pressures of actuation.file" if scene.variant("actuation") == "table" else "actuation.pressure")
+              else "the pressures of actuation.file" if table else "actuation.pressure")
     oil = (0.0, float(max_pressure)) if max_pressure is not None else run_oil_pressures(scene)
-    pack = pack_pressure(scene, oil)
+    pack = pack_pressure(scene, oil, film)
     if pack.pressure_Pa <= capacity.pressure_Pa:
+        if remember:
+            _PASSED[scene] = (capacity, pack)
         return capacity, pack
     cap = f"{capacity.pressure_Pa / 1e6:.3g} MPa"
     applied = f"{pack.pressure_Pa / 1e6:.3g} MPa"

@@ -155,8 +155,10 @@ def simulate_engagement(scene, *, rtol=None, atol=None, method="idas", t_end=Non
                 "native": native}
     settings.update(solver_options or {})
     options = SimulationOptions(**settings)
-    grid = np.unique(np.concatenate([np.linspace(0.0, t_end, n_out),
-                                     [b for b in model.actuation.breakpoints() if b < t_end]]))
+    grid = np.linspace(0.0, t_end, n_out)
+    breaks = [b for b in model.actuation.breakpoints() if b < t_end]
+    if breaks:                          # the profile's kinks join the grid (np.unique: sorted, once each)
+        grid = np.unique(np.concatenate([grid, breaks]))
     x0 = dict(zip(model.state_names, model.initial_state))
     for name, value in (initial_state or {}).items():
         if name not in x0:

@@ -220,8 +220,7 @@ class IdasPath:
         self.counters.update(n_integrator_calls=0, n_location_integrations=0, n_probe_integrations=0,
                              n_integrators_built=0, integration_time_s=0.0)
         self.counters.update({f"n_pieces_{k}": 0 for k in SCHEMES}, n_adams_redone_bdf=0)
-        self._options_key = {k: repr(sorted(self._idas_options(1.0, k).items())) + f"native={options.native}"
-                             for k in SCHEMES}
+        self._options_key = {}      # scheme -> the cache key of its options (_options_key_of), on first use
         self._schemes = {}          # mode name -> scheme of its current piece (begin_piece)
         self._stiff = set()         # modes whose Adams integration failed in this run: BDF from then on
 
@@ -265,12 +264,21 @@ class IdasPath:
             opts.update(o.idas_options)
         return opts
 
+    def _options_key_of(self, scheme):
+        """The part of an integrator's cache key that stands for its options (computed once per run
+        and scheme: most runs use one scheme of three)."""
+        key = self._options_key.get(scheme)
+        if key is None:
+            key = self._options_key[scheme] = (repr(sorted(self._idas_options(1.0, scheme).items()))
+                                               + f"native={self.options.native}")
+        return key
+
     def _integrator(self, cm, taus, span, scheme):
         """The cached integrator (``scheme``) of ``cm`` with outputs at normalised times ``taus``."""
         n = len(taus)
         uniform = float(np.max(np.abs(taus - _counting(n) / n))) <= 1e-9
         pattern = n if uniform else tuple(np.round(taus, 12))
-        key = (self._options_key[scheme], pattern, span if self.options.max_step is not None else None)
+        key = (self._options_key_of(scheme), pattern, span if self.options.max_step is not None else None)
         cache = cm.integrators.setdefault(scheme, OrderedDict())
         entry = cache.get(key)
         if entry is None:

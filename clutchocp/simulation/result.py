@@ -61,6 +61,14 @@ class LazyOutputs(Mapping):
             values = self._values[name]
         return values
 
+    def get(self, name, default=None):
+        """``self[name]``, or ``default`` if ``name`` is not an output here (without raising and
+        catching a KeyError, as ``Mapping.get`` does: a summary asks ~50 times)."""
+        values = self._values.get(name)
+        if values is not None:
+            return values
+        return self[name] if name in self._known else default
+
     def __iter__(self):
         return iter(self._names)
 
@@ -107,6 +115,16 @@ class Segment:
 
     def names(self):
         return list(self.x) + list(self.z) + list(self.outputs)
+
+    def values_of(self, name, default=None):
+        """The samples of state, algebraic variable or output ``name`` (looked up in that order), or
+        ``default``; an output is evaluated only when no state or algebraic variable has the name."""
+        values = self.x.get(name)
+        if values is None:
+            values = self.z.get(name)
+        if values is None:
+            values = self.outputs.get(name, default)
+        return values
 
 
 @dataclass
@@ -156,7 +174,7 @@ class SimulationResult:
                            f"known: {self.names()}")
         parts = []
         for seg in self.segments:
-            values = seg.x.get(name, seg.z.get(name, seg.outputs.get(name)))
+            values = seg.values_of(name)
             parts.append(np.full(seg.t.size, np.nan) if values is None else values)
         return np.concatenate(parts)
 
@@ -170,7 +188,7 @@ class SimulationResult:
     def final(self, name):
         """Value of ``name`` at the last sample (in the final mode)."""
         seg = self.segments[-1]
-        return float(seg.x.get(name, seg.z.get(name, seg.outputs.get(name, [np.nan])))[-1])
+        return float(seg.values_of(name, [np.nan])[-1])
 
     def event_times(self, name=None):
         """Times of all switches (or of the events called ``name``)."""

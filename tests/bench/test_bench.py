@@ -62,6 +62,40 @@ def test_whole_over_floor_divides_the_whole_run_speedup_by_the_floor():
     assert bench_run.whole_over_floor(entry) == {"whole_over_floor_vs_radau": 0.5, "whole_over_floor_vs_lsoda": None}
 
 
+def _rows(times):
+    """Work-precision rows from ``{method: [(error, wall_time_s, integration_time_s), ...]}``."""
+    return [{"method": m, "status": "ok", "error": e, "wall_time_s": w, "integration_time_s": i}
+            for m, pts in times.items() for e, w, i in pts]
+
+
+def test_whole_over_floor_bound_divides_the_peer_time_by_idas_integration_time_then_by_the_floor():
+    rows = _rows({"idas": [(1e-4, 2.0, 1.0), (1e-6, 4.0, 2.5), (1e-8, 8.0, 4.0)],
+                  "Radau": [(1e-4, 10.0, 9.0), (1e-6, 40.0, 30.0), (1e-8, 160.0, 150.0)]})
+    entry = {"floor_speedup_vs_radau": 40.0, "floor_speedup_vs_lsoda": 5.0}
+    # by hand, at the log-midpoints 1e-5 and 1e-7: Radau's wall time sqrt(10 * 40) = 20 and
+    # sqrt(40 * 160) = 80, IDAS's integration time sqrt(1 * 2.5) and sqrt(2.5 * 4); the geometric
+    # mean of the two ratios is sqrt(20 * 80 / sqrt(25)) = sqrt(320); over the floor 40
+    bound = bench_run.whole_over_floor_bound(rows, entry, levels=(1e-5, 1e-7))
+    assert bound["whole_over_floor_bound_vs_radau"] == pytest.approx(math.sqrt(320.0) / 40.0, rel=1e-12)
+    assert bound["whole_over_floor_bound_vs_lsoda"] is None                 # no LSODA rows
+    # whole / floor from the wall times: IDAS sqrt(2 * 4) and sqrt(4 * 8), so sqrt(20 * 80 / 16) / 40
+    whole = wp.headline(wp.speedups(rows, peers=("Radau",), levels=(1e-5, 1e-7))["Radau"])[0]
+    assert whole / 40.0 == pytest.approx(0.25, rel=1e-12)
+    assert bound["whole_over_floor_bound_vs_radau"] >= whole / 40.0
+
+
+def test_whole_over_floor_bound_is_whole_over_floor_over_the_integrator_share_of_the_run():
+    # IDAS spends a fixed share of every run inside its integrator calls: the bound is whole / floor
+    # over that share, so never below whole / floor
+    for share in (1.0, 0.7, 0.25):
+        rows = _rows({"idas": [(e, 3.0 * e**-0.2, share * 3.0 * e**-0.2) for e in (1e-4, 1e-6, 1e-8)],
+                      "LSODA": [(e, 9.0 * e**-0.3, 1.0) for e in (1e-4, 1e-6, 1e-8)]})
+        entry = {"floor_speedup_vs_lsoda": 4.0, "speedup_vs_lsoda": wp.headline(wp.speedups(rows, peers=("LSODA",))["LSODA"])[0]}
+        ratio = bench_run.whole_over_floor(entry, peers=("LSODA",))["whole_over_floor_vs_lsoda"]
+        bound = bench_run.whole_over_floor_bound(rows, entry, peers=("LSODA",))["whole_over_floor_bound_vs_lsoda"]
+        assert bound == pytest.approx(ratio / share, rel=1e-12) and bound >= ratio
+
+
 def test_growth_exponent_of_a_power_law():
     n = np.array([1, 2, 4, 8, 16])
     assert scaling.growth_exponent(n, 3e-3 * n**1.25) == pytest.approx(1.25, rel=1e-12)
@@ -234,6 +268,13 @@ def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
         assert entry[key] is not None and entry[key] > 0
     assert written["scenes"]["zhang2021"].keys() >= {"whole_over_floor_vs_radau", "whole_over_floor_vs_lsoda"}
     assert entry["whole_over_floor_vs_radau"] == bench_run.whole_over_floor(entry)["whole_over_floor_vs_radau"]
+    rows_written = [{**r, "error": float(r["error"]), "wall_time_s": float(r["wall_time_s"]),
+                     "integration_time_s": float(r["integration_time_s"])} for r in rows]
+    for peer in ("radau", "lsoda"):       # the bound, recomputed from the written rows, is above whole / floor
+        bound = bench_run.whole_over_floor_bound(rows_written, entry)[f"whole_over_floor_bound_vs_{peer}"]
+        assert entry[f"whole_over_floor_bound_vs_{peer}"] == pytest.approx(bound, rel=1e-9)
+        assert bound > entry[f"whole_over_floor_vs_{peer}"]      # integrator calls are part of the run
     assert written["single_run_s"] == {}          # bao2020 not among the scenes: not timed
     text = bench_run.format_summary(summary)
     assert "issue" not in text and "target" not in text and "integrator floor" in text
+    assert "no time outside the integrator calls" in text

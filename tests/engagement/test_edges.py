@@ -112,6 +112,32 @@ def test_the_optimiser_bound_is_checked_up_to_max_pressure():
         check_contact_capacity(scene, max_pressure=scene.value("actuation.max_pressure"))
 
 
+def test_a_passed_check_is_remembered_per_scene_and_a_failed_one_is_not(monkeypatch):
+    """A run checks its scene before it starts: the second check of the same scene object returns the
+    first's numbers without evaluating the contact law again; a bound, a refused scene and a new scene
+    object are checked anew, with the same numbers as a film law built for each function."""
+    from clutchocp.engagement import edges
+    scene = load_scene("default_driveline")
+    first = check_contact_capacity(scene)
+    assert first == (contact_capacity(scene), pack_pressure(scene, edges.run_oil_pressures(scene)))
+
+    def unbuilt(*args, **kwargs):
+        raise AssertionError("the film law was built again")
+
+    monkeypatch.setattr(edges, "FilmLaw", unbuilt)
+    again = check_contact_capacity(scene)
+    assert again[0] is first[0] and again[1] is first[1]
+    with pytest.raises(AssertionError, match="built again"):           # a bound is checked every time
+        check_contact_capacity(scene, max_pressure=1e6)
+    with pytest.raises(AssertionError, match="built again"):           # so is another scene object
+        check_contact_capacity(load_scene("default_driveline"))
+    monkeypatch.undo()
+    refused = load_scene("default_driveline", SIGMA_6UM)
+    for _ in range(2):
+        with pytest.raises(PhysicalRangeError):
+            check_contact_capacity(refused)
+
+
 def test_a_piston_scene_names_the_oil_pressure_that_fits():
     scene = load_scene("default_fill", {"roughness.sigma": "6 um", "actuation.pressure": "0.9 MPa"})
     with pytest.raises(PhysicalRangeError, match=r"applies 0.842 MPa on the pack \(at 0.9 MPa of oil, springs "

@@ -96,6 +96,7 @@ from .phases import Phase, PhasedNLP, phased_derivatives
 from .quiet import native_output_caught
 from .replay import simulate_command
 
+LOCK_MARGIN = 0.005      # slipping over locked torque at lock-up, minus one (the default; see above)
 JUMP_MODES = ("constraint", "penalty")
 # A film may open (cavitated) no faster than its averaged Reynolds film would at this multiple of the
 # cavitation pressure (see EngagementOCP._cavitation_rows)
@@ -226,7 +227,7 @@ class EngagementOCP:
     theta_value = np.zeros(0)
 
     def __init__(self, scene, *, intervals=100, degree=3, scheme="radau", control="linear", rate_limit=None,
-                 h_min=None, jump="constraint", lock_margin=0.005, smooth=True, polish=True,
+                 h_min=None, jump="constraint", lock_margin=LOCK_MARGIN, smooth=True, polish=True,
                  transcription=None, baseline=None, fill_intervals=30, jerk_max=None, quasi_static_plates=None,
                  max_temperature_C=None, max_specific_power_W_mm2=None, meshes=None, models=None, kiss_bound=False):
         if jump not in JUMP_MODES:

@@ -76,6 +76,7 @@ field::
     curve = "nominal"                # the curve the loop tracks: "nominal" optimum or "robust" feedforward
     t_max_fraction = 1.0             # the nominal optimum is solved with t_max x this (a time margin)
     pressure_reserve = "0 MPa"       # and with the pressure limit lowered by this (headroom for the loop)
+    lock_margin = 0.005              # and landing this fraction above the locked torque (its jump: -this)
 
     [schedule]                       # the TCU measures this field (the oil viscosity, from its temperature)
     field = "oil.viscosity"          # feedforward and gains designed at `points` values over its spread
@@ -86,6 +87,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..control.spec import check_tables, parse_table, read_spec
+from ..optimal.problem import LOCK_MARGIN
 from ..errors import MissingParameterError, ParameterTypeError, PhysicalRangeError
 
 TYPES = ("slip_lqi",)
@@ -140,7 +142,7 @@ _LOCK = {"slip": ("rad/s", "nonnegative", None), "samples": ("1", "positive", 2.
 _ACCEPTANCE = {"lock_by_t_max": ("1", "positive", 1.01), "jump_p95_pct": ("1", "positive", 3.0),
                "jump_worst_pct": ("1", "positive", 6.0), "jerk_ratio": ("1", "positive", 1.15)}
 _FEEDFORWARD = {"curve": ("choice", CURVES, "nominal"), "t_max_fraction": ("1", "positive", 1.0),
-                "pressure_reserve": ("Pa", "nonnegative", 0.0)}
+                "pressure_reserve": ("Pa", "nonnegative", 0.0), "lock_margin": ("1", "nonnegative", LOCK_MARGIN)}
 _SCHEDULE = {"field": ("str", None, ""), "points": ("1", "positive", 1.0)}
 _TABLES = {"controller": _CONTROLLER, "lqi": _LQI, "anti_windup": _ANTI_WINDUP, "estimator": _ESTIMATOR,
            "feedforward": _FEEDFORWARD, "schedule": _SCHEDULE, "sensors": _SENSORS, "valve": _VALVE, "lock": _LOCK,
@@ -167,6 +169,7 @@ class SlipControlSpec:
     feedforward_curve: str = "nominal"
     t_max_fraction: float = 1.0
     pressure_reserve: float = 0.0
+    lock_margin: float = LOCK_MARGIN
     schedule_field: str = ""
     schedule_points: int = 1
     sensors: dict = field(default_factory=dict)           # [sensors.*] tables given (SI), by sub-table
@@ -222,6 +225,13 @@ def parse_slip_spec(raw):
     if reserve > 0 and values["feedforward"]["curve"] == "robust":
         raise PhysicalRangeError(f"feedforward.pressure_reserve = {reserve:g} Pa needs feedforward.curve = "
                                  "\"nominal\" (the reserve lowers the nominal optimum's pressure limit)")
+    lock_margin = values["feedforward"]["lock_margin"]
+    if lock_margin >= 0.5:
+        raise PhysicalRangeError(f"feedforward.lock_margin = {lock_margin:g}: must be in [0, 0.5) (the nominal "
+                                 "optimum's slipping torque at lock-up over the locked torque, minus one)")
+    if lock_margin != LOCK_MARGIN and values["feedforward"]["curve"] == "robust":
+        raise PhysicalRangeError(f"feedforward.lock_margin = {lock_margin:g} needs feedforward.curve = \"nominal\" "
+                                 "(the margin is the nominal optimum's)")
     estimator = values["estimator"]
     weights = values["lqi"]
     terminal = [key for key in ("terminal_slip_tolerance", "terminal_slip_rate_tolerance") if weights[key] is not None]
@@ -284,7 +294,7 @@ def parse_slip_spec(raw):
                            progress=c["progress"], max_delay=c["max_delay"],
                            lqi=weights, anti_windup=values["anti_windup"]["method"], estimator=estimator,
                            feedforward_curve=values["feedforward"]["curve"], t_max_fraction=fraction,
-                           pressure_reserve=reserve,
+                           pressure_reserve=reserve, lock_margin=lock_margin,
                            schedule_field=schedule["field"], schedule_points=int(points), sensors=sensors,
                            valve=valve, lock=lock, estimated_parameters=parameters,
                            acceptance=values["acceptance"])

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import ModelError, PhysicalRangeError, SolverError
 from ..optimal.baselines import baseline_label
-from ..optimal.problem import EngagementOCP
+from ..optimal.problem import LOCK_MARGIN, EngagementOCP
 from ..optimal.robust import lock_diagonal, solve_robust
 from .closed_loop import post_lock_command
 from .design import pressure_limits
@@ -148,9 +148,15 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         # the feedforward keeps a pressure reserve for the feedback: its optimum is solved with the limit lowered
         say(f"  nominal optimum for the closed loop with a pressure reserve of {reserve / 1e6:g} MPa "
             f"(limit {(p_top - reserve) / 1e6:g} MPa)")
-    ff_label = ("nominal optimum" if margin or reserve > 0 else feedforward[0].replace("_", " ")) \
+    # the nominal optimum the loop tracks may land further above the locked torque (feedforward.lock_margin)
+    landing = spec.lock_margin if feedforward[0] != "robust_feedforward" else LOCK_MARGIN
+    if landing != LOCK_MARGIN:
+        say(f"  nominal optimum for the closed loop landing {100 * landing:g} % above the locked torque")
+    own = not margin and reserve == 0 and landing == LOCK_MARGIN
+    ff_label = ("nominal optimum" if not own else feedforward[0].replace("_", " ")) \
         + (f" at {spec.t_max_fraction:g} t_max" if margin else "") \
-        + (f" with a {reserve / 1e6:g} MPa reserve" if reserve > 0 else "")
+        + (f" with a {reserve / 1e6:g} MPa reserve" if reserve > 0 else "") \
+        + (f" landing {100 * landing:g} % above the locked torque" if landing != LOCK_MARGIN else "")
 
     def feedforward_for(design_scene):
         # the closed loop's feedforward on a design scene: the curve chosen above on the nominal scene,
@@ -160,8 +166,9 @@ def build_strategies(scene, uncertainty, spec, *, t_max=None, intervals=60, say=
         same = design_scene is scene
         if reserve > 0:
             design_scene = with_pressure_limit(design_scene, pressure_limits(design_scene, spec)[1] - reserve)
-        problem = ocp if same and reserve == 0 else EngagementOCP(design_scene, intervals=intervals)
-        if same and not margin and reserve == 0:
+        problem = ocp if same and reserve == 0 and landing == LOCK_MARGIN else \
+            EngagementOCP(design_scene, intervals=intervals, lock_margin=landing)
+        if same and own:
             return opt.command_times, opt.command
         found = problem.solve(t_max=spec.t_max_fraction * t_max, guess=opt if same else None)
         return found.command_times, found.command
@@ -202,6 +209,7 @@ def _closed_loop_facts(scene, spec, schedule, feedforward):
     adaptive = spec.estimator["enabled"] and schedule.adaptation_off is None
     first = schedule.feedbacks[0]
     facts = {"feedforward": feedforward, "feedforward_t_max_fraction": spec.t_max_fraction,
+             "feedforward_lock_margin": spec.lock_margin,
              "controller": spec.label, "sample_time_s": spec.sample_time,
              "nominal_lock_s": schedule.lock_times[schedule.index(scene)], "progress": spec.progress,
              "measured": list(first.measured), "estimator": bool(adaptive),
@@ -265,6 +273,7 @@ def robust_summary(scene, spec, uncertainty, strategies, facts, rows, *, samples
         "controller": {"name": spec.label, "sample_time_s": spec.sample_time, "lqi": spec.lqi,
                        "anti_windup": spec.anti_windup, "progress": spec.progress,
                        "feedforward_t_max_fraction": spec.t_max_fraction,
+                       "feedforward_lock_margin": spec.lock_margin,
                        "measure_pressure": spec.measure_pressure, "rate_limit_time_s": spec.rate_limit_time},
     }
 

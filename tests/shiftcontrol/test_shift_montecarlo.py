@@ -185,3 +185,41 @@ def test_a_subset_of_strategies_skips_the_robust_feedforward(monkeypatch):
     with pytest.raises(ModelError, match="--strategies open_loop: allowed are baseline"):
         workflow.check_strategies(("open_loop",))
     assert workflow.check_strategies(("closed_loop", "baseline")) == ("baseline", "closed_loop")
+
+
+def test_closed_loop_tracks_an_optimum_landing_above_the_locked_torque_when_asked(monkeypatch):
+    """feedforward.lock_margin = 0.03: the closed loop tracks the nominal optimum whose slipping torque at
+    lock-up is 3 % above the locked torque (the nominal optimum strategy keeps the optimiser's 0.5 %); replayed
+    in IDAS that curve locks with a jump of -3 % of the locked torque."""
+    from dataclasses import replace
+
+    from clutchocp.optimal.problem import LOCK_MARGIN, EngagementOCP
+    from clutchocp.optimal.verify import verify
+    from clutchocp.shiftcontrol import workflow
+    from clutchocp.shiftcontrol.spec import load_slip_spec
+
+    monkeypatch.setattr(workflow, "robust_solver", lambda: None)
+    tracked = []
+    design_schedule = workflow.design_schedule
+
+    def spy(scene, spec, uncertainty, feedforward_for, **kwargs):
+        tracked.append(feedforward_for(scene))
+        return design_schedule(scene, spec, uncertainty, feedforward_for, **kwargs)
+
+    monkeypatch.setattr(workflow, "design_schedule", spy)
+    scene = default_scene()
+    nominal = scene.without_uncertainty()
+    spec = replace(load_slip_spec(), t_max_fraction=1.0, schedule_field="", lock_margin=0.03)
+    strategies, facts = workflow.build_strategies(nominal, Uncertainty.from_scene(scene), spec, intervals=30,
+                                                say=lambda *a: None)
+    assert "landing 3 % above the locked torque" in strategies[-1].label
+    assert facts["closed_loop"]["feedforward_lock_margin"] == 0.03
+    ocp = EngagementOCP(nominal, intervals=30, lock_margin=0.03)
+    opt = ocp.solve(t_max=facts["t_max_s"])
+    times, command = tracked[0]
+    assert np.allclose(times, opt.command_times, rtol=1e-4) and np.allclose(command, opt.command, rtol=1e-3, atol=1e3)
+    idas, _ = verify(ocp, opt)
+    assert idas["torque_jump_Nm"] / idas["jump_reference_Nm"] == pytest.approx(-0.03, abs=0.005)
+    own = EngagementOCP(nominal, intervals=30).solve(t_max=facts["t_max_s"])   # the optimiser's own landing
+    assert own.terms["lockup_torque_jump_Nm"] / opt.terms["lockup_torque_jump_Nm"] == pytest.approx(LOCK_MARGIN / 0.03,
+                                                                                                    rel=1e-6)

@@ -4,6 +4,7 @@ import pytest
 
 from clutchocp.cli import main
 from clutchocp.errors import SceneError
+from clutchocp.optimal.problem import LOCK_MARGIN
 from clutchocp.shiftcontrol.spec import load_slip_spec, parse_slip_spec
 
 GOOD = {"controller": {"type": "slip_lqi", "sample_time": "10 ms"}}
@@ -43,6 +44,8 @@ def test_builtin_spec_loads_with_units():
     assert spec.pressure_reserve == 0.0
     assert parse_slip_spec({**GOOD, "feedforward": {"pressure_reserve": "0.2 MPa"}}).pressure_reserve == \
         pytest.approx(2e5)
+    assert bare.lock_margin == LOCK_MARGIN         # the optimiser's own landing unless the spec says otherwise
+    assert parse_slip_spec({**GOOD, "feedforward": {"lock_margin": 0.02}}).lock_margin == pytest.approx(0.02)
 
 
 @pytest.mark.parametrize("raw, match", [
@@ -63,6 +66,10 @@ def test_builtin_spec_loads_with_units():
     ({**GOOD, "feedforward": {"pressure_reserve": "-0.1 MPa"}}, r"feedforward\.pressure_reserve = '-0\.1 MPa'"),
     ({**GOOD, "feedforward": {"pressure_reserve": "0.1 MPa", "curve": "robust"}},
      r"feedforward\.pressure_reserve = 100000 Pa needs feedforward\.curve = \"nominal\""),
+    ({**GOOD, "feedforward": {"lock_margin": -0.01}}, r"feedforward\.lock_margin = -0\.01: must be >= 0"),
+    ({**GOOD, "feedforward": {"lock_margin": 0.5}}, r"feedforward\.lock_margin = 0\.5: must be in \[0, 0\.5\)"),
+    ({**GOOD, "feedforward": {"lock_margin": 0.02, "curve": "robust"}},
+     r"feedforward\.lock_margin = 0\.02 needs feedforward\.curve = \"nominal\""),
     ({**GOOD, "feedforward": {"t_max_fracton": 0.9}}, r"feedforward\.t_max_fracton: unknown key .*did you mean 't_max_fraction'"),
     ({**GOOD, "estimator": {"activation": 1.5}}, r"estimator\.activation = 1\.5: must be in \(0, 1\)"),
     ({**GOOD, "estimator": {"gain_limit": 0.8}}, r"estimator\.gain_limit = 0\.8: must be above 1"),

@@ -457,10 +457,10 @@ def robust(item):
 TCU_UNCERTAIN = ("actuation.time_constant=uniform 20 %", "driveline.input_torque=uniform 5 %")
 
 
-def tcu_acceptance(item):
+def tcu_acceptance(item, samples=100):
     """The TCU loop's acceptance run: ``slip_lqr_tcu`` closed loop, 100 draws of the box plus the valve lag
     and the engine torque the TCU is not told."""
-    args = ["robust", "--controller", "slip_lqr_tcu", "--strategies", "closed_loop", "--samples", "100",
+    args = ["robust", "--controller", "slip_lqr_tcu", "--strategies", "closed_loop", "--samples", str(samples),
             "--seed", "11", "--workers", "2"]
     for field in TCU_UNCERTAIN:
         args += ["--uncertain", field]
@@ -470,6 +470,11 @@ def tcu_acceptance(item):
     return {"command": "clutchocp " + " ".join(f'"{a}"' if " " in a else a for a in args) + " --out DIR",
             "t_max_s": s["t_max_s"], "acceptance": s["acceptance"]["closed_loop"],
             "statistics": s["statistics"]["closed_loop"], "timing": s["timing"], "written": written}
+
+
+def tcu_thousand(item):
+    """The acceptance run's command on 1000 draws: the closed loop's throughput and its statistics."""
+    return tcu_acceptance(item, samples=1000)
 
 
 def tcu_heldout(item):
@@ -594,15 +599,16 @@ ITEMS = {
     "optimize_refusals": optimize_refusals,
     "tcu_acceptance": tcu_acceptance,
     "tcu_heldout": tcu_heldout,
+    "tcu_thousand": tcu_thousand,
     "bench": bench,
 }
 # Priority of an item's commands when two wait for a slot: the longest first, so that the two slots
 # finish together (robust ~35 %, bench and optimize_scenes ~25 % each of the commands' time).
-ORDER = ("robust", "optimize_scenes", "bench", "tcu_heldout", "tcu_acceptance", "optimize_refusals", "optimize_weights", "sweep", "control", "optimize_default",
+ORDER = ("tcu_thousand", "robust", "optimize_scenes", "bench", "tcu_heldout", "tcu_acceptance", "optimize_refusals", "optimize_weights", "sweep", "control", "optimize_default",
          "simulate_scenes", "physics", "cycles", "readme_example", "validate")
 KEYS_OF = {"optimize": ("optimize_default", "optimize_scenes"), "simulate": ("simulate_scenes",),
            "cycles": ("cycles",), "validate": ("validate",), "control": ("control",), "sweep": ("sweep",),
-           "robust": ("robust", "tcu_acceptance"), "bench": ("bench",)}
+           "robust": ("robust", "tcu_acceptance", "tcu_thousand"), "bench": ("bench",)}
 
 
 # -- examples in the docs --------------------------------------------------------------------------
@@ -823,6 +829,22 @@ def r_tcu_acceptance(n):
               f"{', '.join('`' + f + '`' for f in d['written'])}. (`{d['command']}`; {measured(n, 'tcu_acceptance')}.)\n")
 
 
+def r_tcu_thousand(n):
+    d = n["tcu_thousand"]
+    a, st, tm = d["acceptance"], d["statistics"], d["timing"]
+    jump = st["jump_pct"]
+    rows = [("draws", fmt(st["samples"])),
+            ("Monte Carlo time [s]", fmt(tm["monte_carlo_s"], 3)),
+            ("samples/s", f"{fmt(tm['samples_per_s'], 3)} on {tm['workers']} processes"),
+            ("set-up (designs, feedforwards) [s]", fmt(tm["setup_s"], 3)),
+            ("lock within t_max / by 1.03 t_max", f"{pct(st['lock_within_t_max_share'])} / "
+                                                  f"{pct(a['lock_by_limit_share'])} (the latest at "
+                                                  f"{fmt(a['latest_lock_over_t_max'], 4)} t_max)"),
+            ("\\|jump\\| median / p95 / worst [% of locked torque]",
+             f"{fmt(jump['median'], 3)} / {fmt(jump['p95'], 3)} / {fmt(jump['worst'], 3)}")]
+    return table(("quantity", "value"), rows) + f"\n(`{d['command']}`; {measured(n, 'tcu_thousand')}.)\n"
+
+
 def r_tcu_heldout(n):
     d = n["tcu_heldout"]
 
@@ -1015,6 +1037,7 @@ RENDERERS = {
     "optimize-refusals": r_optimize_refusals,
     "tcu-acceptance": r_tcu_acceptance,
     "tcu-heldout": r_tcu_heldout,
+    "tcu-thousand": r_tcu_thousand,
     "bench": r_bench,
     "physics-wall": r_physics_wall,
     "physics-shear-factors": r_physics_shear_factors,

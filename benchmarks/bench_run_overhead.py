@@ -6,8 +6,9 @@ engagement scene, for this source tree and, side by side in the same run, for an
     PYTHONPATH=. python benchmarks/bench_run_overhead.py --against /tmp/base     # both, interleaved
 
 A point runs as a sweep runs it (:func:`clutchocp.study.tasks.simulate_point`: the scene with the
-point's oil viscosity, one parametric model per process, on CasADi's virtual machine or as compiled
-C). Its share is ``1 - integration_time_s / run_time_s`` of its row (the definition of
+point's oil viscosity (a Walther oil's density, :func:`swept_key`), one parametric model per
+process, on CasADi's virtual machine or as compiled C). Its share is
+``1 - integration_time_s / run_time_s`` of its row (the definition of
 ``benchmarks/bench_sweep.py``), the median over ``--points`` points after ``--warm-up`` points
 (the first builds the model and integrators that later points reuse). Also reported: points per
 second on one core (the inverse of the mean point time), and where a point's time goes (a second
@@ -91,9 +92,18 @@ def _timers(acc):
         compiled.native_events_outputs = merged
 
 
-def point_floor(task, values, repeats=5):
+def swept_key(scene):
+    """The scene key a scene's points sweep: ``oil.viscosity`` [Pa s] for a constant oil,
+    ``oil.density`` [kg/m^3] for a Walther oil. A Walther oil's dynamic viscosity is derived
+    (density times the kinematic viscosity of Walther's law, whose coefficients are fitted from
+    the datasheet viscosities as numbers), so neither it nor the datasheet viscosities can be a
+    parameter of one model for all points; the density scales the dynamic viscosity alike."""
+    return "oil.density" if scene.get("oil.model") == "walther" else "oil.viscosity"
+
+
+def point_floor(task, values, key="oil.viscosity", repeats=5):
     """What a point cannot spend less on outside IDAS without changing its results, per value of
-    the oil viscosity in ``values``:
+    the oil viscosity ``key`` (:func:`swept_key`) in ``values``:
 
     * evaluating the functions its result needs on many samples at once (outputs on the output
       grid, event functions on its samples, merged where the tree merges them): every such call is
@@ -134,7 +144,7 @@ def point_floor(task, values, repeats=5):
         built.clear()
         ColumnFunction.__call__, casadi.integrator = recording, timed_build
         try:
-            row = simulate_point(task, {"oil.viscosity": v})[0]
+            row = simulate_point(task, {key: v})[0]
         finally:
             ColumnFunction.__call__, casadi.integrator = inner, build
         evaluations = 0.0
@@ -168,14 +178,15 @@ def worker(scene, native, points, warm_up):
             cpu["integrator"] += time.thread_time() - start
     idas_path.IdasPath._run = counted
 
-    nominal = load_scene(scene).value("oil.viscosity")
+    key = swept_key(load_scene(scene))
+    nominal = load_scene(scene).value(key)
     task = Task(scene, "simulate", options={"native": "auto" if native else False})
     n = warm_up + points
     values = [nominal * (0.95 + 0.1 * k / (n - 1)) for k in range(n)]
     rows, cpu_shares, cpu_points = [], [], []
     for k, v in enumerate(values):
         cpu["integrator"], start = 0.0, time.thread_time()
-        rows.append(simulate_point(task, {"oil.viscosity": v})[0])
+        rows.append(simulate_point(task, {key: v})[0])
         if k >= warm_up:
             cpu_points.append(time.thread_time() - start)
             cpu_shares.append(1 - cpu["integrator"] / cpu_points[-1])
@@ -189,10 +200,10 @@ def worker(scene, native, points, warm_up):
     _timers(acc)
     start = time.perf_counter()
     for a, b in zip(values[warm_up - 1:], values[warm_up:]):  # new values: nothing cached from the first pass
-        simulate_point(task, {"oil.viscosity": 0.5 * (a + b)})
+        simulate_point(task, {key: 0.5 * (a + b)})
     second = time.perf_counter() - start
     # values met by neither pass (their output patterns are new to this process, as a new sweep point's are)
-    floors = point_floor(task, [(2 * a + b) / 3 for a, b in zip(values[warm_up - 1:], values[warm_up:])])
+    floors = point_floor(task, [(2 * a + b) / 3 for a, b in zip(values[warm_up - 1:], values[warm_up:])], key)
     floor = [f["evaluations_s"] + f["construction_s"] for f in floors]
     return {"floor_evaluations_ms": 1e3 * statistics.median(f["evaluations_s"] for f in floors),
             "floor_construction_ms": 1e3 * statistics.median(f["construction_s"] for f in floors),

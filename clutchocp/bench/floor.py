@@ -69,9 +69,10 @@ def _scipy_piece(path, method, cm, t0, xs0, pu, t1, rtol, atol):
     return sol.y[:, -1]
 
 
-def floor_run(model, parts, method, rtol, repeats=3):
+def floor_run(model, parts, method, rtol, repeats=3, native=False):
     """Integrate every piece once per repeat with ``method`` at ``rtol`` (atol = rtol x
-    :data:`~clutchocp.bench.workprecision.ATOL_RATIO`).
+    :data:`~clutchocp.bench.workprecision.ATOL_RATIO`); ``native``: the engine's integrators on the
+    equations compiled to machine code (``SimulationOptions.native``, the floor of ``"idas-native"``).
 
     Returns
     -------
@@ -84,7 +85,7 @@ def floor_run(model, parts, method, rtol, repeats=3):
         raise ClutchocpError("the integrator floor needs a model with its parameters built in (no free inputs)")
     pu = np.zeros(0)                                  # the engagement model's values are built in
     atol = rtol * workprecision.ATOL_RATIO
-    options = SimulationOptions(rtol=rtol, atol=atol)
+    options = SimulationOptions(rtol=rtol, atol=atol, native=native)
     path = IdasPath(options) if method == "idas" else ScipyPath(method, options)
     best, error = math.inf, 0.0
     for attempt in range(max(1, repeats) + 1):       # the first pass builds and caches the integrators

@@ -1,0 +1,233 @@
+"""Benchmark (not a test): the time a whole IDAS engagement run may take for `clutchocp bench`'s
+``whole / floor >= 0.6``, against where its time goes, per engagement scene and tolerance.
+
+    PYTHONPATH=. python benchmarks/bench_whole_run_budget.py                      # the three scenes below 0.6
+    PYTHONPATH=. python benchmarks/bench_whole_run_budget.py --scenes bao2020 --rtols 1e-7
+
+``whole / floor`` (:func:`clutchocp.bench.run.whole_over_floor`) is IDAS's whole-run speed-up over
+Radau divided by its floor's: ``(T_floor / T_whole) x (R_whole / R_floor)`` for IDAS times ``T`` and
+Radau times ``R``. At one tolerance, ``whole / floor >= TARGET`` allows an IDAS run at most
+``T_floor x R_whole / (TARGET x R_floor)``: the *budget* (the bench takes the ratios at matched
+error, averaged over error levels; here they are taken at equal rtol, one tolerance at a time).
+
+The whole run's time (the best of ``--repeats`` runs, wall clock, the model built and its
+integrators cached by untimed runs) is split with timers around:
+
+* ``integrator_calls``: the IDAS/CVODES calls (``IdasPath._run``); ``integrator_excess`` is their
+  time beyond the floor's (the calls start and stop where the run finds its events);
+* ``grid_evaluations``: functions evaluated on two or more samples (outputs and event functions on
+  the output grid, ``ColumnFunction``), in the hybrid loop and in the summary;
+* ``summary``: :func:`clutchocp.engagement.measures.summarize` without its evaluations;
+* ``loop``: the rest (call planning, event scan and location logic, resets, one-sample evaluations,
+  result assembly).
+
+``whole_over_floor_without_loop`` is the ratio a run would reach if its loop cost nothing: its
+integrator calls as they are (results unchanged), its grid evaluations and summary.
+
+The Radau run pays the same grid evaluations and summary after its integration. ``engine``: ``vm``
+(CasADi's virtual machine and numpy, the default) and ``native`` (the equations, outputs and event
+functions compiled to C, ``simulate_engagement(native=True)``; its floor integrates the compiled
+equations). Results go to ``bench_whole_run_budget.json`` in ``--out`` and a table to stdout.
+"""
+
+import argparse
+import functools
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+SCENES = ("zhang2021", "default_driveline", "default_driveline_thermal")
+TARGET = 0.6
+
+
+def budget(t_floor, r_whole, r_floor, target=TARGET):
+    """Largest IDAS whole-run time [s] with ``whole / floor >= target``, from the IDAS floor time and
+    the Radau whole-run and floor times [s] at the same tolerance."""
+    return t_floor * r_whole / (target * r_floor)
+
+
+def whole_over_floor(t_whole, t_floor, r_whole, r_floor):
+    """``whole / floor`` at one tolerance: ``(t_floor / t_whole) x (r_whole / r_floor)`` (IDAS and Radau times)."""
+    return (t_floor / t_whole) * (r_whole / r_floor)
+
+
+class PartTimers:
+    """Wall-clock timers around the parts of an engagement run (see the module docstring), installed
+    on the classes until :meth:`remove`; only the outermost of nested grid evaluations counts."""
+
+    def __init__(self):
+        import clutchocp.engagement.run as run
+        import clutchocp.simulation.compiled as compiled
+        import clutchocp.simulation.idas_path as idas_path
+
+        self.parts, self._depth, self._in_summary, self._undo = {}, 0, False, []
+        self._wrap(idas_path.IdasPath, "_run", self._timed("integrator_calls"))
+        for name in ("__call__", "on_numpy"):
+            self._wrap(compiled.ColumnFunction, name, self._evaluation)
+        self._wrap(run, "summarize", self._summary)
+
+    def _wrap(self, owner, name, make):
+        inner = getattr(owner, name)
+        setattr(owner, name, functools.wraps(inner)(make(inner)))
+        self._undo.append((owner, name, inner))
+
+    def remove(self):
+        for owner, name, inner in reversed(self._undo):
+            setattr(owner, name, inner)
+
+    def _add(self, label, seconds):
+        self.parts[label] = self.parts.get(label, 0.0) + seconds
+
+    def _timed(self, label):
+        def make(inner):
+            def timed(*args, **kwargs):
+                start = time.perf_counter()
+                try:
+                    return inner(*args, **kwargs)
+                finally:
+                    self._add(label, time.perf_counter() - start)
+            return timed
+        return make
+
+    def _evaluation(self, inner):
+        def timed(column, xs, zs, pu, t, *rest):
+            many = np.size(t) >= 2 and self._depth == 0
+            self._depth += 1
+            start = time.perf_counter()
+            try:
+                return inner(column, xs, zs, pu, t, *rest)
+            finally:
+                self._depth -= 1
+                if many:
+                    seconds = time.perf_counter() - start
+                    self._add("grid_evaluations", seconds)
+                    if self._in_summary:
+                        self._add("summary_evaluations", seconds)
+        return timed
+
+    def _summary(self, inner):
+        def timed(*args, **kwargs):
+            self._in_summary = True
+            start = time.perf_counter()
+            try:
+                return inner(*args, **kwargs)
+            finally:
+                self._in_summary = False
+                self._add("summary_total", time.perf_counter() - start)
+        return timed
+
+
+def whole_run_parts(scene, model, method, rtol, repeats):
+    """The fastest of ``repeats`` timed runs (after two untimed ones): its time [s] and its parts [s]."""
+    from clutchocp.bench.workprecision import run_method
+
+    for _ in range(2):
+        run_method(scene, model, method, rtol)
+    timers = PartTimers()
+    best = (math.inf, None)
+    try:
+        for _ in range(repeats):
+            timers.parts = {}
+            start = time.perf_counter()
+            run_method(scene, model, method, rtol)
+            elapsed = time.perf_counter() - start
+            if elapsed < best[0]:
+                best = (elapsed, dict(timers.parts))
+    finally:
+        timers.remove()
+    whole, parts = best
+    summary = parts.get("summary_total", 0.0) - parts.get("summary_evaluations", 0.0)
+    named = {"integrator_calls": parts.get("integrator_calls", 0.0),
+             "grid_evaluations": parts.get("grid_evaluations", 0.0), "summary": summary}
+    named["loop"] = whole - sum(named.values())
+    return whole, named
+
+
+def plain_time(scene, model, method, rtol, repeats):
+    """Best wall time [s] of ``repeats`` runs without timers (after two untimed ones)."""
+    from clutchocp.bench.workprecision import timed_run
+
+    timed_run(scene, model, method, rtol, repeats=2)
+    return timed_run(scene, model, method, rtol, repeats=repeats)[0]
+
+
+def measure(name, rtols, repeats, engines):
+    """One scene: JSON-ready rows, one per (engine, rtol)."""
+    from clutchocp.bench import floor
+    from clutchocp.bench.workprecision import REFERENCE_RTOL, run_method
+    from clutchocp.engagement.model import EngagementModel
+    from clutchocp.scene import load_scene
+
+    scene = load_scene(name)
+    model = EngagementModel(scene)
+    parts = floor.pieces(run_method(scene, model, "idas", REFERENCE_RTOL))
+    rows = []
+    for rtol in rtols:
+        r_whole = plain_time(scene, model, "Radau", rtol, max(3, repeats // 3))
+        r_floor = floor.floor_run(model, parts, "Radau", rtol, repeats=max(3, repeats // 3))[0]
+        for engine in engines:
+            method = "idas-native" if engine == "native" else "idas"
+            t_whole = plain_time(scene, model, method, rtol, repeats)
+            t_floor = floor.floor_run(model, parts, "idas", rtol, repeats=repeats, native=engine == "native")[0]
+            timed_whole, split = whole_run_parts(scene, model, method, rtol, repeats)
+            allowed = budget(t_floor, r_whole, r_floor)
+            rows.append({
+                "scene": name, "engine": engine, "rtol": rtol,
+                "whole_over_floor": whole_over_floor(t_whole, t_floor, r_whole, r_floor),
+                "whole_over_floor_without_loop": whole_over_floor(
+                    split["integrator_calls"] + split["grid_evaluations"] + split["summary"], t_floor, r_whole, r_floor),
+                "idas_whole_ms": 1e3 * t_whole, "idas_floor_ms": 1e3 * t_floor,
+                "radau_whole_ms": 1e3 * r_whole, "radau_floor_ms": 1e3 * r_floor,
+                "budget_ms": 1e3 * allowed, "budget_beyond_floor_ms": 1e3 * (allowed - t_floor),
+                "radau_beyond_floor_ms": 1e3 * (r_whole - r_floor),
+                "timed_whole_ms": 1e3 * timed_whole,
+                "parts_ms": {k: 1e3 * v for k, v in split.items()},
+                "integrator_excess_ms": 1e3 * (split["integrator_calls"] - t_floor),
+                "after_integration_ms": 1e3 * (split["grid_evaluations"] + split["summary"]),
+            })
+            print(_line(rows[-1]), file=sys.stderr, flush=True)
+    return rows
+
+
+def _line(row):
+    p = row["parts_ms"]
+    return (f"{row['scene']:<26} {row['engine']:<6} rtol {row['rtol']:.0e}: whole/floor {row['whole_over_floor']:.2f} "
+            f"(without the loop {row['whole_over_floor_without_loop']:.2f}); "
+            f"IDAS whole {row['idas_whole_ms']:.2f} ms, budget {row['budget_ms']:.2f} ms (floor {row['idas_floor_ms']:.2f} "
+            f"+ {row['budget_beyond_floor_ms']:.2f}); timed run {row['timed_whole_ms']:.2f} ms = integrator calls "
+            f"{p['integrator_calls']:.2f} (floor + {row['integrator_excess_ms']:.2f}) + grid evaluations "
+            f"{p['grid_evaluations']:.2f} + summary {p['summary']:.2f} + loop {p['loop']:.2f}; "
+            f"Radau beyond its floor {row['radau_beyond_floor_ms']:.2f} ms")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--out", default="out/bench_whole_run_budget")
+    parser.add_argument("--scenes", default=",".join(SCENES))
+    parser.add_argument("--rtols", default="1e-6,1e-7,1e-8", help="integration tolerances (default 1e-6,1e-7,1e-8)")
+    parser.add_argument("--repeats", type=int, default=15, help="timed IDAS runs per point, best counts (Radau: a third, at least 3)")
+    parser.add_argument("--engines", default="vm,native", help="vm, native or both (native needs a C compiler)")
+    args = parser.parse_args(argv)
+    rtols = [float(r) for r in args.rtols.split(",")]
+    engines = args.engines.split(",")
+    unknown = sorted(set(engines) - {"vm", "native"})
+    if unknown:
+        parser.error(f"--engines takes vm and native (got {', '.join(unknown)})")
+    if args.repeats < 1:
+        parser.error(f"--repeats must be >= 1 (got {args.repeats})")
+    rows = [row for name in args.scenes.split(",") for row in measure(name, rtols, args.repeats, engines)]
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    result = {"target": TARGET, "repeats": args.repeats, "rows": rows}
+    (out / "bench_whole_run_budget.json").write_text(json.dumps(result, indent=2) + "\n")
+    for row in rows:
+        print(_line(row))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

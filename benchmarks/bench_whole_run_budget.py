@@ -13,7 +13,7 @@ error, averaged over error levels; here they are taken at equal rtol, one tolera
 The whole run's time (the best of ``--repeats`` runs, wall clock, the model built and its
 integrators cached by untimed runs) is split with timers around:
 
-* ``integrator_calls``: the IDAS/CVODES calls (``IdasPath._run``); ``integrator_excess`` is their
+* ``integrator_calls``: the IDAS/CVODES calls (``IdasPath._run``); ``integrator_excess_ms`` is their
   time beyond the floor's (the calls start and stop where the run finds its events);
 * ``grid_evaluations``: functions evaluated on two or more samples (outputs and event functions on
   the output grid, ``ColumnFunction``), in the hybrid loop and in the summary;

@@ -51,8 +51,12 @@ def budget(t_floor, r_whole, r_floor, target=TARGET):
 
 
 def whole_over_floor(t_whole, t_floor, r_whole, r_floor):
-    """``whole / floor`` at one tolerance: ``(t_floor / t_whole) x (r_whole / r_floor)`` (IDAS and Radau times)."""
-    return (t_floor / t_whole) * (r_whole / r_floor)
+    """``whole / floor`` at one tolerance from IDAS and Radau times [s]: the bench's own ratio
+    (:func:`clutchocp.bench.run.whole_over_floor`) of these speed-ups."""
+    from clutchocp.bench.run import whole_over_floor as ratio
+
+    entry = {"speedup_vs_radau": r_whole / t_whole, "floor_speedup_vs_radau": r_floor / t_floor}
+    return ratio(entry, peers=("Radau",))["whole_over_floor_vs_radau"]
 
 
 class PartTimers:

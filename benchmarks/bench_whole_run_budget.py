@@ -24,6 +24,17 @@ integrators cached by untimed runs) is split with timers around:
 ``whole_over_floor_without_loop`` is the ratio a run would reach if its loop cost nothing: its
 integrator calls as they are (results unchanged), its grid evaluations and summary.
 
+``summary_work_ms`` is the work every whole run does after its integration, IDAS's and Radau's alike:
+the outputs the summary reads, evaluated afresh on the run's samples, and the summary itself
+(:func:`summary_work`). ``whole_over_floor_ideal`` is the ratio of an IDAS run that cost its floor plus
+that work and nothing else (no event detection or location, no call beyond the floor's, no loop):
+what no change to the IDAS path can beat while the summary costs what it does. ``path_overhead_ms``
+is what the run spends beyond floor and summary work (calls beyond the floor, event functions on the
+grid, the loop), ``path_allowance_ms`` what the target leaves for it (``budget - floor - summary work``).
+``whole_over_floor_calls_and_summary`` is the ratio of a run made of its integrator calls as they are
+and the summary work alone: the most any hybrid loop reaches without changing where the calls start
+and stop (which moves IDAS's steps, so results by more than 1e-10).
+
 The Radau run pays the same grid evaluations and summary after its integration. ``engine``: ``vm``
 (CasADi's virtual machine and numpy, the default) and ``native`` (the equations, outputs and event
 functions compiled to C, ``simulate_engagement(native=True)``; its floor integrates the compiled
@@ -31,6 +42,7 @@ equations). Results go to ``bench_whole_run_budget.json`` in ``--out`` and a tab
 """
 
 import argparse
+import copy
 import functools
 import json
 import math
@@ -125,6 +137,61 @@ class PartTimers:
         return timed
 
 
+def evaluators(result):
+    """The lazy-output evaluators of ``result``'s segments (each keeps its segment's scaled samples); to be
+    taken before the summary reads the outputs (an evaluator is let go once every output is read)."""
+    return [seg.outputs._evaluate for seg in result.segments]
+
+
+def unevaluated(result, model, kept):
+    """A copy of the engagement ``result`` whose outputs are evaluated afresh when read (none is yet),
+    from the run's own scaled samples held by its evaluators ``kept`` (:func:`evaluators`), the way its
+    lazy outputs evaluate them (on CasADi's virtual machine and numpy, or compiled)."""
+    from clutchocp.simulation.driver import _SegmentOutputs
+    from clutchocp.simulation.result import LazyOutputs, Segment
+
+    compiled = model.hybrid.compiled()
+    segments = []
+    for seg, evaluator in zip(result.segments, kept):
+        cm = compiled[seg.mode]
+        block = (evaluator.t, evaluator.xs, evaluator.zs, np.zeros(0), None)   # the model's values are built in
+        outputs = LazyOutputs(cm.output_names, _SegmentOutputs(cm, [block], evaluator.t, evaluator.xs, evaluator.zs,
+                                                               evaluator.native))
+        segments.append(Segment(seg.mode, seg.t, seg.x, seg.z, outputs))
+    fresh = copy.copy(result)
+    fresh.segments = segments
+    return fresh
+
+
+def summary_work(scene, model, method, rtol, repeats):
+    """Best time [s] of ``repeats`` evaluations of a run's summary from its samples alone: the outputs
+    it reads (evaluated afresh) and :func:`clutchocp.engagement.measures.summarize`; and that summary
+    (the run's own, timing keys aside, for the check)."""
+    import clutchocp.engagement.run as run_module
+    from clutchocp.bench.workprecision import run_method
+
+    calls = []
+    inner = run_module.summarize
+
+    def captured(*args):
+        calls.append((args, evaluators(args[1])))
+        return inner(*args)
+
+    run_module.summarize = captured
+    try:
+        run_method(scene, model, method, rtol)
+    finally:
+        run_module.summarize = inner
+    ((args, kept),) = calls
+    best, summary = math.inf, None
+    for _ in range(repeats + 1):                # the first evaluation builds the output functions used
+        fresh = unevaluated(args[1], model, kept)
+        start = time.perf_counter()
+        summary = inner(args[0], fresh, *args[2:])
+        best = min(best, time.perf_counter() - start)
+    return best, summary
+
+
 def whole_run_parts(scene, model, method, rtol, repeats):
     """The fastest of ``repeats`` timed runs (after two untimed ones): its time [s] and its parts [s]."""
     from clutchocp.bench.workprecision import run_method
@@ -179,6 +246,7 @@ def measure(name, rtols, repeats, engines):
             t_floor = floor.floor_run(model, parts, "idas", rtol, repeats=repeats, native=engine == "native")[0]
             timed_whole, split = whole_run_parts(scene, model, method, rtol, repeats)
             allowed = budget(t_floor, r_whole, r_floor)
+            work = summary_work(scene, model, method, rtol, repeats)[0]
             rows.append({
                 "scene": name, "engine": engine, "rtol": rtol,
                 "whole_over_floor": whole_over_floor(t_whole, t_floor, r_whole, r_floor),
@@ -191,6 +259,12 @@ def measure(name, rtols, repeats, engines):
                 "timed_whole_ms": 1e3 * timed_whole,
                 "parts_ms": {k: 1e3 * v for k, v in split.items()},
                 "integrator_excess_ms": 1e3 * (split["integrator_calls"] - t_floor),
+                "summary_work_ms": 1e3 * work,
+                "whole_over_floor_ideal": whole_over_floor(t_floor + work, t_floor, r_whole, r_floor),
+                "whole_over_floor_calls_and_summary": whole_over_floor(
+                    split["integrator_calls"] + work, t_floor, r_whole, r_floor),
+                "path_overhead_ms": 1e3 * (t_whole - t_floor - work),
+                "path_allowance_ms": 1e3 * (allowed - t_floor - work),
                 "after_integration_ms": 1e3 * (split["grid_evaluations"] + split["summary"]),
             })
             print(_line(rows[-1]), file=sys.stderr, flush=True)
@@ -205,7 +279,10 @@ def _line(row):
             f"+ {row['budget_beyond_floor_ms']:.2f}); timed run {row['timed_whole_ms']:.2f} ms = integrator calls "
             f"{p['integrator_calls']:.2f} (floor + {row['integrator_excess_ms']:.2f}) + grid evaluations "
             f"{p['grid_evaluations']:.2f} + summary {p['summary']:.2f} + loop {p['loop']:.2f}; "
-            f"Radau beyond its floor {row['radau_beyond_floor_ms']:.2f} ms")
+            f"Radau beyond its floor {row['radau_beyond_floor_ms']:.2f} ms; summary work {row['summary_work_ms']:.2f} ms: "
+            f"ideal whole/floor {row['whole_over_floor_ideal']:.2f}, with the calls as they are "
+            f"{row['whole_over_floor_calls_and_summary']:.2f}, IDAS path {row['path_overhead_ms']:.2f} ms "
+            f"against an allowance of {row['path_allowance_ms']:.2f} ms")
 
 
 def main(argv=None):

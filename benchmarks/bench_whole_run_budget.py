@@ -26,7 +26,7 @@ integrator calls as they are (results unchanged), its grid evaluations and summa
 
 ``summary_work_ms`` is the work every whole run does after its integration, IDAS's and Radau's alike:
 the outputs the summary reads, evaluated afresh on the run's samples, and the summary itself
-(:func:`summary_work`). ``whole_over_floor_ideal`` is the ratio of an IDAS run that cost its floor plus
+(:mod:`clutchocp.bench.summary_work`). ``whole_over_floor_ideal`` is the ratio of an IDAS run that cost its floor plus
 that work and nothing else (no event detection or location, no call beyond the floor's, no loop):
 what no change to the IDAS path can beat while the summary costs what it does. ``path_overhead_ms``
 is what the run spends beyond floor and summary work (calls beyond the floor, event functions on the
@@ -42,7 +42,6 @@ equations). Results go to ``bench_whole_run_budget.json`` in ``--out`` and a tab
 """
 
 import argparse
-import copy
 import functools
 import json
 import math
@@ -137,59 +136,25 @@ class PartTimers:
         return timed
 
 
-def evaluators(result):
-    """The lazy-output evaluators of ``result``'s segments (each keeps its segment's scaled samples); to be
-    taken before the summary reads the outputs (an evaluator is let go once every output is read)."""
-    return [seg.outputs._evaluate for seg in result.segments]
-
-
-def unevaluated(result, model, kept):
-    """A copy of the engagement ``result`` whose outputs are evaluated afresh when read (none is yet),
-    from the run's own scaled samples held by its evaluators ``kept`` (:func:`evaluators`), the way its
-    lazy outputs evaluate them (on CasADi's virtual machine and numpy, or compiled)."""
-    from clutchocp.simulation.driver import _SegmentOutputs
-    from clutchocp.simulation.result import LazyOutputs, Segment
-
-    compiled = model.hybrid.compiled()
-    segments = []
-    for seg, evaluator in zip(result.segments, kept):
-        cm = compiled[seg.mode]
-        block = (evaluator.t, evaluator.xs, evaluator.zs, np.zeros(0), None)   # the model's values are built in
-        outputs = LazyOutputs(cm.output_names, _SegmentOutputs(cm, [block], evaluator.t, evaluator.xs, evaluator.zs,
-                                                               evaluator.native))
-        segments.append(Segment(seg.mode, seg.t, seg.x, seg.z, outputs))
-    fresh = copy.copy(result)
-    fresh.segments = segments
-    return fresh
-
-
 def summary_work(scene, model, method, rtol, repeats):
-    """Best time [s] of ``repeats`` evaluations of a run's summary from its samples alone: the outputs
-    it reads (evaluated afresh) and :func:`clutchocp.engagement.measures.summarize`; and that summary
-    (the run's own, timing keys aside, for the check)."""
+    """Best time [s] of the summary work of a run (:func:`clutchocp.bench.summary_work.summary_time`),
+    its samples taken before its summary reads the outputs (a native run reads them all)."""
     import clutchocp.engagement.run as run_module
+    from clutchocp.bench.summary_work import evaluators, summary_time
     from clutchocp.bench.workprecision import run_method
 
-    calls = []
-    inner = run_module.summarize
+    kept, inner = [], run_module.summarize
 
-    def captured(*args):
-        calls.append((args, evaluators(args[1])))
-        return inner(*args)
+    def taking(model, result, *rest):
+        kept.append(evaluators(result))
+        return inner(model, result, *rest)
 
-    run_module.summarize = captured
+    run_module.summarize = taking
     try:
-        run_method(scene, model, method, rtol)
+        run = run_method(scene, model, method, rtol)
     finally:
         run_module.summarize = inner
-    ((args, kept),) = calls
-    best, summary = math.inf, None
-    for _ in range(repeats + 1):                # the first evaluation builds the output functions used
-        fresh = unevaluated(args[1], model, kept)
-        start = time.perf_counter()
-        summary = inner(args[0], fresh, *args[2:])
-        best = min(best, time.perf_counter() - start)
-    return best, summary
+    return summary_time(run, repeats, kept=kept[0])[0]
 
 
 def whole_run_parts(scene, model, method, rtol, repeats):
@@ -246,7 +211,7 @@ def measure(name, rtols, repeats, engines):
             t_floor = floor.floor_run(model, parts, "idas", rtol, repeats=repeats, native=engine == "native")[0]
             timed_whole, split = whole_run_parts(scene, model, method, rtol, repeats)
             allowed = budget(t_floor, r_whole, r_floor)
-            work = summary_work(scene, model, method, rtol, repeats)[0]
+            work = summary_work(scene, model, method, rtol, repeats)
             rows.append({
                 "scene": name, "engine": engine, "rtol": rtol,
                 "whole_over_floor": whole_over_floor(t_whole, t_floor, r_whole, r_floor),

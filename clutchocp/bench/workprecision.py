@@ -20,7 +20,9 @@ machine precision on its dense output.
 
 Wall times are of the whole ``simulate_engagement`` call (integration, event location, outputs,
 summary) with the model built and its integrators cached by an untimed warm-up run; the best of
-``repeats`` runs counts. Times at matched error come from the Pareto front of each method's
+``repeats`` runs counts. An IDAS row also gets the time of its run's summary work (the outputs its
+summary reads, evaluated afresh, and the summary: :mod:`clutchocp.bench.summary_work`), which
+every whole run pays whatever integrates it. Times at matched error come from the Pareto front of each method's
 (error, time) points, interpolated in log-log (:func:`time_at_error`).
 """
 
@@ -34,6 +36,7 @@ from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..errors import ClutchocpError, ModelError
 from ..output import new_figure, save_figure, write_csv
+from .summary_work import summary_time
 
 METHODS = ("idas", "idas-native", "cvodes", "Radau", "BDF", "LSODA")
 SCIPY = ("Radau", "BDF", "LSODA")
@@ -196,6 +199,8 @@ def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=
                     progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: FAILED ({str(exc)[:70]}...)")
                 continue
             stats = run.summary["solver"]["statistics"]
+            if method == "idas":        # before the errors read more outputs
+                row["summary_work_s"] = summary_time(run, count)[0]
             errors = trajectory_errors(run, reference)
             row.update(status="ok", wall_time_s=wall, cpu_time_s=cpu, error=errors["max"],
                        integration_time_s=stats.get("integration_time_s"),
@@ -283,7 +288,7 @@ def headline(ratios):
 
 
 SWEEP_COLUMNS = ("scene", "method", "rtol", "atol", "status", "wall_time_s", "cpu_time_s", "integration_time_s",
-                 "error", *(f"error_{k}" for k in ERROR_PARTS), "engagement_time_s", "n_steps", "n_rhs_evals",
+                 "summary_work_s", "error", *(f"error_{k}" for k in ERROR_PARTS), "engagement_time_s", "n_steps", "n_rhs_evals",
                  "n_jacobian_evals")
 
 

@@ -44,29 +44,6 @@ def test_parts_of_a_run_add_up_and_the_timers_are_removed():
     assert row["budget_ms"] > row["idas_floor_ms"] > 0
 
 
-def _without_timing(summary):
-    return {k: v for k, v in summary.items() if k not in ("wall_time_s", "solver")}   # solver: its statistics
-
-
-def test_summary_work_computes_the_runs_own_summary_from_its_samples_alone():
-    from clutchocp.bench.workprecision import run_method
-    from clutchocp.engagement.model import EngagementModel
-    from clutchocp.scene import load_scene
-
-    bench = _bench()
-    scene = load_scene("zhang2021")
-    model = EngagementModel(scene)
-    run = run_method(scene, model, "idas", 1e-5)
-    kept = bench.evaluators(run.result)
-    seconds, summary = bench.summary_work(scene, model, "idas", 1e-5, repeats=2)
-    assert seconds > 0
-    assert _without_timing(summary) == _without_timing(run.summary)
-    fresh = bench.unevaluated(run.result, model, kept)
-    assert all(not seg.outputs.evaluated() for seg in fresh.segments)      # nothing carried over from the run
-    for name in ("total_torque_Nm", "output_jerk_rad_s3"):
-        assert (fresh[name] == run.result[name]).all()
-
-
 def test_ideal_ratio_is_that_of_a_run_costing_its_floor_plus_the_summary_work():
     (row,) = _bench().measure("zhang2021", [1e-5], repeats=1, engines=["vm"])
     floor, work, whole = row["idas_floor_ms"], row["summary_work_ms"], row["idas_whole_ms"]

@@ -33,7 +33,7 @@ is what the run spends beyond floor and summary work (calls beyond the floor, ev
 grid, the loop), ``path_allowance_ms`` what the target leaves for it (``budget - floor - summary work``).
 ``whole_over_floor_calls_and_summary`` is the ratio of a run made of its integrator calls as they are
 and the summary work alone: the most any hybrid loop reaches without changing where the calls start
-and stop (which moves IDAS's steps, so results by more than 1e-10).
+and stop (which moves IDAS's steps, so its results).
 
 The Radau run pays the same grid evaluations and summary after its integration. ``engine``: ``vm``
 (CasADi's virtual machine and numpy, the default) and ``native`` (the equations, outputs and event

@@ -44,9 +44,11 @@ from . import floor, optimization, scaling, workprecision
 from .progress import Progress
 
 FULL = {"tolerances": workprecision.TOLERANCES, "methods": workprecision.METHODS, "repeats": 3,
-        "scaling_repeats": 3}
+        "scaling_repeats": 3, "floor_repeats": 3}
+# quick: single timings, but three of every run whole / floor is made of (the floor's peers' whole
+# runs and every floor point): a single timing of one of them moved it by up to 0.07 between runs
 QUICK = {"tolerances": workprecision.TOLERANCES, "methods": ("idas", "cvodes", "Radau", "BDF", "LSODA"),
-         "repeats": 1, "scaling_repeats": 1}
+         "repeats": 1, "scaling_repeats": 1, "floor_repeats": 3}
 SINGLE_RUN_SCENE = "bao2020"     # the scene of the single-run timing
 
 
@@ -93,9 +95,10 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
     for scene in scenes:
         model = EngagementModel(scene)
         res = workprecision.sweep(scene, methods=settings["methods"], tolerances=settings["tolerances"],
-                                  repeats=settings["repeats"], progress=bar, model=model)
+                                  repeats=settings["repeats"], progress=bar, model=model,
+                                  least_repeats={peer: settings["floor_repeats"] for peer in floor.PEERS})
         results.append(res)
-        low = floor.integrator_floor(res["reference_run"], res["rows"], repeats=settings["repeats"], progress=bar)
+        low = floor.integrator_floor(res["reference_run"], res["rows"], repeats=settings["floor_repeats"], progress=bar)
         floors[scene.name] = low.pop("rows")
         bar.step(f"{scene.name}: integrator floor {low['floor_speedup_vs_radau'] or math.nan:.1f}x over Radau, "
                  f"{low['floor_speedup_vs_lsoda'] or math.nan:.1f}x over LSODA")
@@ -125,7 +128,8 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
 
     summary = {"quick": quick, "scenes": per_scene, "optimization": opt_summary,
                "settings": {"tolerances": list(settings["tolerances"]), "methods": list(settings["methods"]),
-                            "repeats": settings["repeats"], "reference_rtol": workprecision.REFERENCE_RTOL,
+                            "repeats": settings["repeats"], "floor_repeats": settings["floor_repeats"],
+                            "reference_rtol": workprecision.REFERENCE_RTOL,
                             "atol_over_rtol": workprecision.ATOL_RATIO,
                             "matched_error_levels": list(workprecision.ERROR_LEVELS)},
                "single_run_s": single, "idas_slower": idas_slower(per_scene), "wall_time_s": time.perf_counter() - start}

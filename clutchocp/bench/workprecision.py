@@ -149,7 +149,14 @@ def reference_runs(scene, model):
     return reference, confirmation
 
 
-def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=None, model=None):
+def timed_runs(method, repeats, least_repeats=None):
+    """Timed runs per sweep point of ``method``: ``repeats``, three times as many for the engine
+    methods (short, noisy runs), at least ``least_repeats[method]`` where given."""
+    count = repeats * (3 if method in ("idas", "idas-native", "cvodes") else 1)
+    return max(count, (least_repeats or {}).get(method, 1))
+
+
+def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=None, model=None, least_repeats=None):
     """Every method over the tolerance sweep on one scene, against the reference.
 
     Parameters
@@ -159,6 +166,9 @@ def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=
     repeats : int
         Timed runs per point (the best counts); the engine methods, whose runs are short and
         noisy, get three times as many.
+    least_repeats : dict, optional
+        ``{method: n}``: at least ``n`` timed runs per point for these methods (e.g. the peers a
+        ratio of the bench divides by, whose single timings move it by several per cent).
     progress : clutchocp.bench.progress.Progress, optional
     model : EngagementModel, optional
 
@@ -190,7 +200,7 @@ def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=
             row = {"scene": scene.name, "method": method, "rtol": rtol, "atol": rtol * ATOL_RATIO}
             start = time.perf_counter()
             try:
-                count = repeats * (3 if method in ("idas", "idas-native", "cvodes") else 1)
+                count = timed_runs(method, repeats, least_repeats)
                 wall, cpu, run = timed_run(scene, model, method, rtol, count)
             except ClutchocpError as exc:   # e.g. scipy BDF's step size collapsing at the impact
                 row.update(status=f"failed: {str(exc)[:200]}", wall_time_s=time.perf_counter() - start)

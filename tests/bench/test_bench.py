@@ -112,6 +112,13 @@ def test_summary_bound_adds_idas_summary_work_to_its_integrator_calls():
     assert "calls_and_summary_s" not in rows[0]                     # the rows are left as they were
 
 
+def test_timed_runs_per_point():
+    assert wp.timed_runs("idas", 1) == 3 and wp.timed_runs("Radau", 1) == 1
+    least = {"Radau": 3, "LSODA": 3}
+    assert wp.timed_runs("Radau", 1, least) == 3 and wp.timed_runs("BDF", 1, least) == 1
+    assert wp.timed_runs("idas", 2, least) == 6 and wp.timed_runs("LSODA", 5, least) == 5
+
+
 def test_growth_exponent_of_a_power_law():
     n = np.array([1, 2, 4, 8, 16])
     assert scaling.growth_exponent(n, 3e-3 * n**1.25) == pytest.approx(1.25, rel=1e-12)

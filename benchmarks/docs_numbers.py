@@ -507,6 +507,16 @@ def optimize_refusals(item):
     return {"rows": rows}
 
 
+def first_call_stop(item):
+    """``benchmarks/bench_first_call_stop.py``: what a first call that stopped at its event would save,
+    and CasADi's own event stop."""
+    code = ("import runpy, sys; sys.argv = ['bench_first_call_stop.py', '--out', '.']; "
+            f"runpy.run_path({str(ROOT / 'benchmarks' / 'bench_first_call_stop.py')!r}, run_name='__main__')")
+    run = item.python(code, "first_call_stop")
+    data = json.loads((run.folder / "bench_first_call_stop.json").read_text())
+    return {"command": "PYTHONPATH=. python benchmarks/bench_first_call_stop.py", **data}
+
+
 def bench(item):
     """``clutchocp bench --quick``: IDAS against scipy's integrators at matched error."""
     run = item.clutchocp("bench", "--quick")
@@ -601,11 +611,12 @@ ITEMS = {
     "tcu_heldout": tcu_heldout,
     "tcu_thousand": tcu_thousand,
     "bench": bench,
+    "first_call_stop": first_call_stop,
 }
 # Priority of an item's commands when two wait for a slot: the longest first, so that the two slots
 # finish together (robust ~35 %, bench and optimize_scenes ~25 % each of the commands' time).
 ORDER = ("tcu_thousand", "robust", "optimize_scenes", "bench", "tcu_heldout", "tcu_acceptance", "optimize_refusals", "optimize_weights", "sweep", "control", "optimize_default",
-         "simulate_scenes", "physics", "cycles", "readme_example", "validate")
+         "simulate_scenes", "physics", "cycles", "readme_example", "first_call_stop", "validate")
 KEYS_OF = {"optimize": ("optimize_default", "optimize_scenes"), "simulate": ("simulate_scenes",),
            "cycles": ("cycles",), "validate": ("validate",), "control": ("control",), "sweep": ("sweep",),
            "robust": ("robust", "tcu_acceptance", "tcu_thousand"), "bench": ("bench",)}
@@ -887,6 +898,26 @@ def r_bench(n):
               f"`{n['bench']['command']}`; {measured(n, 'bench')}.)\n")
 
 
+def r_first_call_stop(n):
+    d = n["first_call_stop"]
+    rows = [(f"`{r['scene']}`", f"{r['event_t_s']:.4g} / {r['piece_end_s']:g}",
+             f"{r['full_ms']:.2f} ({r['full_steps']})", f"{r['past']}", f"{r['ended_ms']:.2f} ({r['ended_steps']})",
+             fmt(r["ended_change"], 2), f"{r['casadi_zero_ms']:.2f} ({r['casadi_zero_steps']})",
+             fmt(r["zero_change"], 2), f"{r['whole_ms']:.2f}", f"{100 * r['ended_saving_share']:.1f} %",
+             f"{1 / (1 - r['ended_saving_share']):.2f}")
+            for r in d["rows"]]
+    rtols = sorted({r["rtol"] for r in d["rows"]})
+    return (table(("scene", "event / piece end [s]", "first call to the piece end: ms (steps)",
+                   "ended past the event: grid intervals", "ended: ms (steps)", "ended: samples changed",
+                   "CasADi zero events: ms (steps)", "zero events: samples changed", "whole run [ms]",
+                   "ended call saves", "whole / floor factor"), rows)
+            + f"\n(rtol {', '.join(f'{r:g}' for r in rtols)}; the first integrator call of the slipping piece, best of "
+              "15 calls; samples changed: the largest change of the scaled states before the event against the "
+              "call to the piece end; whole / floor factor: 1 / (1 - saving), the most an ended first call would "
+              f"raise whole / floor by with every other time unchanged; `{d['command']}`; "
+              f"{measured(n, 'first_call_stop')}.)\n")
+
+
 # -- docs/physics.md ---------------------------------------------------------------------------------
 def _phys(n):
     return n["physics"]
@@ -1042,6 +1073,7 @@ RENDERERS = {
     "tcu-heldout": r_tcu_heldout,
     "tcu-thousand": r_tcu_thousand,
     "bench": r_bench,
+    "first-call-stop": r_first_call_stop,
     "physics-wall": r_physics_wall,
     "physics-shear-factors": r_physics_shear_factors,
     "physics-shear-effect": r_physics_shear_effect,

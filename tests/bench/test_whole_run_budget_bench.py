@@ -55,3 +55,21 @@ def test_ideal_ratio_is_that_of_a_run_costing_its_floor_plus_the_summary_work():
     assert row["whole_over_floor_calls_and_summary"] == pytest.approx(
         (floor / (calls + work)) * (row["radau_whole_ms"] / row["radau_floor_ms"]), rel=1e-12)
     assert row["whole_over_floor"] < row["whole_over_floor_ideal"]
+
+
+def test_event_work_is_the_event_functions_on_the_samples_each_piece_keeps():
+    from clutchocp.bench.workprecision import run_method
+    from clutchocp.engagement.model import EngagementModel
+    from clutchocp.scene import load_scene
+
+    scene = load_scene("zhang2021")
+    model = EngagementModel(scene)
+    inner = IdasPath.advance
+    seconds = _bench().event_work(scene, model, "idas", 1e-5, repeats=2)
+    assert IdasPath.advance is inner                                        # the spy is removed
+    assert 0 < seconds < run_method(scene, model, "idas", 1e-5).result.stats["wall_time_s"]
+    (row,) = _bench().measure("zhang2021", [1e-5], repeats=1, engines=["vm"])
+    calls, work, events = row["parts_ms"]["integrator_calls"], row["summary_work_ms"], row["event_work_ms"]
+    assert row["whole_over_floor_calls_summary_events"] == pytest.approx(
+        (row["idas_floor_ms"] / (calls + work + events)) * (row["radau_whole_ms"] / row["radau_floor_ms"]), rel=1e-12)
+    assert row["whole_over_floor_calls_summary_events"] < row["whole_over_floor_calls_and_summary"]

@@ -6,7 +6,6 @@ cheap numbers are computed again, every Python example in docs/ runs, every summ
 CSV column a command writes is on its page, and every .md path a doc names exists.
 """
 
-import importlib.util
 import json
 import os
 import re
@@ -19,6 +18,7 @@ import pytest
 import clutchocp
 from clutchocp.cli import build_parser, main
 from clutchocp.scene import load_scene
+from repo_scripts import load_script
 
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
@@ -28,10 +28,7 @@ LIVE_REL_TOL = 1e-3
 
 
 def load_docs_numbers():
-    spec = importlib.util.spec_from_file_location("docs_numbers", ROOT / "benchmarks" / "docs_numbers.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("benchmarks/docs_numbers.py")
 
 
 dn = load_docs_numbers()

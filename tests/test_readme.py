@@ -1,11 +1,11 @@
 """The README: short, the two set-up commands CI runs at its top, an example whose printed numbers are true."""
 
-import importlib.util
 import os
 import re
 import subprocess
 import sys
 from pathlib import Path
+from repo_scripts import load_script
 
 ROOT = Path(__file__).resolve().parent.parent
 README = (ROOT / "README.md").read_text(encoding="utf-8")
@@ -16,10 +16,7 @@ SETUP = (
 
 
 def load_docs_numbers():
-    spec = importlib.util.spec_from_file_location("docs_numbers", ROOT / "benchmarks" / "docs_numbers.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("benchmarks/docs_numbers.py")
 
 
 def test_readme_is_read_in_five_minutes():

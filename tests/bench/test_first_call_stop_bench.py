@@ -2,21 +2,14 @@
 takes fewer steps than the call to the end of the piece; CasADi's event stop leaves the samples
 before the crossing, and the one after it, in the output buffer."""
 
-import importlib.util
-from pathlib import Path
-
 import pytest
 
 from clutchocp.simulation.idas_path import IdasPath
-
-ROOT = Path(__file__).resolve().parents[2]
+from repo_scripts import load_script
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_first_call_stop", ROOT / "benchmarks" / "bench_first_call_stop.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("benchmarks/bench_first_call_stop.py")
 
 
 def test_an_ended_first_call_keeps_its_samples_and_saves_steps():

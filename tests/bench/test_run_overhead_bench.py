@@ -2,22 +2,16 @@
 dynamic viscosity of a constant oil, the density of a Walther oil (whose dynamic viscosity is derived:
 a point overriding it fails, and its datasheet viscosities cannot be parameters)."""
 
-import importlib.util
-from pathlib import Path
 
 import pytest
 
 from clutchocp.scene import load_scene
 from clutchocp.study.tasks import Task, simulate_point
-
-ROOT = Path(__file__).resolve().parents[2]
+from repo_scripts import load_script
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_run_overhead", ROOT / "benchmarks" / "bench_run_overhead.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("benchmarks/bench_run_overhead.py")
 
 
 @pytest.mark.parametrize("scene, key", [("zhang2021", "oil.viscosity"),

@@ -1,23 +1,15 @@
 """benchmarks/bench_whole_run_budget.py: its ratio is the bench's whole / floor, its budget the run time
 at which that ratio meets the target, and its timers split a run without counting anything twice."""
 
-import importlib.util
-from pathlib import Path
-
 import pytest
 
 from clutchocp.simulation.compiled import ColumnFunction
 from clutchocp.simulation.idas_path import IdasPath
-
-ROOT = Path(__file__).resolve().parents[2]
+from repo_scripts import load_script
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_whole_run_budget",
-                                                  ROOT / "benchmarks" / "bench_whole_run_budget.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("benchmarks/bench_whole_run_budget.py")
 
 
 def test_budget_is_the_run_time_at_which_the_bench_ratio_meets_the_target():

@@ -3,20 +3,17 @@ clutch ends in an optimum IDAS confirms, each deliberately infeasible one in a o
 physical limit (the classification of benchmarks/bench_catalogue.py). Slow: 27 optimisations, about an hour
 on two loaded cores (run with -m slow)."""
 
-import importlib.util
 from pathlib import Path
 
 import pytest
+from repo_scripts import load_script
 
 ROOT = Path(__file__).resolve().parents[2]
 CATALOGUE = sorted((ROOT / "models" / "catalogue").glob("*.toml"))
 
 
 def _bench():
-    spec = importlib.util.spec_from_file_location("bench_catalogue", ROOT / "benchmarks" / "bench_catalogue.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("benchmarks/bench_catalogue.py")
 
 
 @pytest.mark.slow

@@ -71,13 +71,9 @@ def delayed_events(cm, lag_tau):
     ``s - lag_tau ds/dtau`` on the normalised-time DAE's variables."""
     import casadi as ca
 
-    from clutchocp.simulation.derivative import time_derivative
-
     dae = cm.dae_tau
     tau, t0, span = dae["t"], dae["p"][-2], dae["p"][-1]
-    s = cm._event_functions
-    z, alg = (ca.vertsplit(cm.zs), ca.vertsplit(cm.alg_s)) if cm.nz else (None, None)
-    slope = time_derivative(s, ca.vertsplit(cm.xs), ca.vertsplit(cm.ode_s), z=z, alg=alg, t=cm.t)
+    s, slope, _ = cm.event_rates()
     return ca.substitute(s - lag_tau * span * slope, cm.t, t0 + tau * span)
 
 

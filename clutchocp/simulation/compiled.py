@@ -250,6 +250,7 @@ class CompiledMode:
         self._event_functions = scaled(functions)
         self._rootfinder = None
         self._z_explicit = None
+        self._event_rates = None
         self._event_slopes = None
         self._native_dae = None
         self._native_outputs_on = None
@@ -279,17 +280,25 @@ class CompiledMode:
             self.resets.append(_function(f"{mode.name}_reset_{ev.name}", [self.xs, self.zs, self.pu, self.t],
                                          [expr], f"the reset of event '{ev.name}'", mode.name))
 
-    def event_slopes(self):
-        """Column function ``(xs, zs, pu, t) -> (3 n_events, n)``: the scaled event functions, then
-        their first, then their second time derivatives along the flow (to predict crossings)."""
-        if self._event_slopes is None:
+    def event_rates(self):
+        """The scaled event functions and their first and second time derivatives along the flow, as
+        SX expressions of ``(xs, zs, pu, t)`` (built on first use and kept)."""
+        if self._event_rates is None:
             x, ode = ca.vertsplit(self.xs), ca.vertsplit(self.ode_s)
             z, alg = (ca.vertsplit(self.zs), ca.vertsplit(self.alg_s)) if self.nz else (None, None)
             s = self._event_functions
             s1 = time_derivative(s, x, ode, z=z, alg=alg, t=self.t) if s.numel() else s
             s2 = time_derivative(s1, x, ode, z=z, alg=alg, t=self.t) if s.numel() else s
+            self._event_rates = (s, s1, s2)
+        return self._event_rates
+
+    def event_slopes(self):
+        """Column function ``(xs, zs, pu, t) -> (3 n_events, n)``: the scaled event functions, then
+        their first, then their second time derivatives along the flow (to predict crossings)."""
+        if self._event_slopes is None:
             self._event_slopes = ColumnFunction(ca.Function(
-                f"{self.name}_event_slopes", [self.xs, self.zs, self.pu, self.t], [ca.densify(ca.cse(ca.vertcat(s, s1, s2)))]))
+                f"{self.name}_event_slopes", [self.xs, self.zs, self.pu, self.t],
+                [ca.densify(ca.cse(ca.vertcat(*self.event_rates())))]))
         return self._event_slopes
 
     def outputs_subset(self, indices):

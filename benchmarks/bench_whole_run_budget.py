@@ -34,9 +34,9 @@ grid, the loop), ``path_allowance_ms`` what the target leaves for it (``budget -
 ``whole_over_floor_calls_and_summary`` is the ratio of a run made of its integrator calls as they are
 and the summary work alone: the most any hybrid loop reaches without changing where the calls start
 and stop (which moves IDAS's steps, so its results). ``event_work_ms`` is the event detection no
-loop can skip while the grid detects the events: the event functions on every sample a piece keeps,
-one call a piece; ``whole_over_floor_calls_summary_events`` the ratio of a run made of its calls,
-the summary work and that event work.
+loop can skip while the grid detects the events: the event functions on every sample a run keeps
+(:mod:`clutchocp.bench.event_work`, the bench's ``event_work_s``); ``whole_over_floor_calls_summary_events``
+the ratio of a run made of its calls, the summary work and that event work.
 
 The Radau run pays the same grid evaluations and summary after its integration. ``engine``: ``vm``
 (CasADi's virtual machine and numpy, the default) and ``native`` (the equations, outputs and event
@@ -139,10 +139,12 @@ class PartTimers:
         return timed
 
 
-def summary_work(scene, model, method, rtol, repeats):
-    """Best time [s] of the summary work of a run (:func:`clutchocp.bench.summary_work.summary_time`),
-    its samples taken before its summary reads the outputs (a native run reads them all)."""
+def summary_and_event_work(scene, model, method, rtol, repeats):
+    """Best times [s] of the summary work (:func:`clutchocp.bench.summary_work.summary_time`) and of the
+    event work (:func:`clutchocp.bench.event_work.event_work_time`) of one run, its samples taken
+    before its summary reads the outputs (a native run reads them all)."""
     import clutchocp.engagement.run as run_module
+    from clutchocp.bench.event_work import event_work_time
     from clutchocp.bench.summary_work import evaluators, summary_time
     from clutchocp.bench.workprecision import run_method
 
@@ -157,39 +159,7 @@ def summary_work(scene, model, method, rtol, repeats):
         run = run_method(scene, model, method, rtol)
     finally:
         run_module.summarize = inner
-    return summary_time(run, repeats, kept=kept[0])[0]
-
-
-def event_work(scene, model, method, rtol, repeats):
-    """Best time [s] of the event detection a run cannot skip: its modes' scaled event functions on
-    the samples each piece keeps, evaluated as the run evaluates them on the grid
-    (:meth:`~clutchocp.simulation.compiled.CompiledMode.event_values`), one call a piece; the pieces
-    are those of one run, taken as it goes."""
-    import clutchocp.simulation.idas_path as idas_path
-    from clutchocp.bench.workprecision import run_method
-
-    pieces, inner = [], idas_path.IdasPath.advance
-
-    def keeping(path, cm, t_a, xs_a, zs_a, pu, times, monitor):
-        advance = inner(path, cm, t_a, xs_a, zs_a, pu, times, monitor)
-        if cm.events and advance.t.size:
-            pieces.append((cm.event_values(path.options.native), np.array(advance.xs), np.array(advance.zs),
-                           np.array(pu, float), np.array(advance.t)))
-        return advance
-
-    idas_path.IdasPath.advance = keeping
-    try:
-        run_method(scene, model, method, rtol)
-    finally:
-        idas_path.IdasPath.advance = inner
-    best = math.inf
-    for attempt in range(repeats + 1):          # the first builds the maps of these sample counts
-        start = time.perf_counter()
-        for evaluate, xs, zs, pu, t in pieces:
-            evaluate(xs, zs, pu, t)
-        if attempt:
-            best = min(best, time.perf_counter() - start)
-    return best
+    return summary_time(run, repeats, kept=kept[0])[0], event_work_time(run, repeats, kept=kept[0])
 
 
 def whole_run_parts(scene, model, method, rtol, repeats):
@@ -246,8 +216,7 @@ def measure(name, rtols, repeats, engines):
             t_floor = floor.floor_run(model, parts, "idas", rtol, repeats=repeats, native=engine == "native")[0]
             timed_whole, split = whole_run_parts(scene, model, method, rtol, repeats)
             allowed = budget(t_floor, r_whole, r_floor)
-            work = summary_work(scene, model, method, rtol, repeats)
-            events = event_work(scene, model, method, rtol, repeats)
+            work, events = summary_and_event_work(scene, model, method, rtol, repeats)
             rows.append({
                 "scene": name, "engine": engine, "rtol": rtol,
                 "whole_over_floor": whole_over_floor(t_whole, t_floor, r_whole, r_floor),

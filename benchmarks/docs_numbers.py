@@ -883,18 +883,21 @@ def r_bench(n):
     rows = [(f"`{name}`", fmt(v.get("speedup_vs_radau"), 3), fmt(v.get("speedup_vs_bdf"), 3),
              fmt(v.get("speedup_vs_lsoda"), 3), fmt(v.get("floor_speedup_vs_radau"), 3),
              fmt(v.get("whole_over_floor_vs_radau"), 2), fmt(v.get("whole_over_floor_bound_vs_radau"), 2),
-             fmt(v.get("whole_over_floor_summary_bound_vs_radau"), 2), fmt(v.get("scaling_exponent_pairs"), 3))
+             fmt(v.get("whole_over_floor_summary_bound_vs_radau"), 2),
+             fmt(v.get("whole_over_floor_events_bound_vs_radau"), 2), fmt(v.get("scaling_exponent_pairs"), 3))
             for name, v in scenes.items()]
     return (table(("scene", "IDAS speed-up vs Radau", "vs BDF", "vs LSODA", "integrator floor vs Radau",
                    "whole / floor", "bound (no time outside the integrator)", "bound (no time outside the integrator "
-                   "and the summary work)", "run time ~ pairs^k: k"), rows)
+                   "and the summary work)", "bound (... and the event checks)", "run time ~ pairs^k: k"), rows)
             + "\n(speed-ups at matched error, the geometric mean over the error levels both reach; whole / floor: the "
               "whole run's speed-up over Radau divided by the floor's, below 1 where the run spends time outside "
               "the integrator: output grid, event location, summary; bound: the whole / floor a run would reach "
               "with its integrator calls as they are and no time outside them (they start and stop where the run "
               "finds its events, the floor's at the known event times); bound with the summary work: the same with "
               "the work every whole run does after its integration, Radau's too (the outputs its summary reads and "
-              "the summary), added to IDAS's calls: what a hybrid loop costing nothing would reach; "
+              "the summary), added to IDAS's calls; bound with the event checks: the same with the event functions "
+              "on the samples the run keeps added too, the detection a run that finds its events on its output "
+              "grid cannot skip: what a hybrid loop costing nothing else would reach; "
               f"`{n['bench']['command']}`; {measured(n, 'bench')}.)\n")
 
 

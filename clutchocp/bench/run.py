@@ -19,8 +19,10 @@
   ``floor_speedup_vs_<peer>``; 1 when a whole run costs over the floor what the peer's does), and
   the most a whole run could keep with its integrator calls as they are, spending no time outside
   them (``whole_over_floor_bound_vs_radau``, ``whole_over_floor_bound_vs_lsoda``,
-  :func:`whole_over_floor_bound`), and spending no time outside them and the summary work every
-  whole run does (``whole_over_floor_summary_bound_vs_radau``, ``..._vs_lsoda``);
+  :func:`whole_over_floor_bound`), spending no time outside them and the summary work every
+  whole run does (``whole_over_floor_summary_bound_vs_radau``, ``..._vs_lsoda``), and outside them,
+  the summary work and the event checks on the samples the run keeps
+  (``whole_over_floor_events_bound_vs_radau``, ``..._vs_lsoda``);
   ``idas_slower``: every scene, peer and matched error level at which a peer was faster than IDAS
   (a measured fact, not a target); ``single_run_s``: one warm bao2020 engagement at its settings;
 * ``engagement_integrator_floor.csv`` -- the floor of every method and tolerance (also drawn,
@@ -109,8 +111,8 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
                                                                  repeats=settings["scaling_repeats"], progress=bar)
         per_scene[scene.name] = {**_scene_summary(res, profile, scaling_results[scene.name], speed_rows), **low}
         per_scene[scene.name].update(whole_over_floor(per_scene[scene.name]))
-        per_scene[scene.name].update(whole_over_floor_bound(res["rows"], per_scene[scene.name]))
-        per_scene[scene.name].update(whole_over_floor_bound(res["rows"], per_scene[scene.name], with_summary=True))
+        for work in BOUND_WORK:
+            per_scene[scene.name].update(whole_over_floor_bound(res["rows"], per_scene[scene.name], work=work))
 
     files.append(workprecision.write_rows(out / "engagement_work_precision.csv", [r for res in results for r in res["rows"]]))
     files.append(workprecision.write_rows(out / "engagement_integrator_floor.csv", [r for rows in floors.values() for r in rows],
@@ -184,47 +186,50 @@ def whole_over_floor(entry, peers=floor.PEERS):
     return out
 
 
-def whole_over_floor_bound(rows, entry, peers=floor.PEERS, levels=workprecision.ERROR_LEVELS, with_summary=False):
-    """The whole / floor a run would reach if it spent no time outside its integrator calls (with
-    ``with_summary``: outside its integrator calls and its summary work).
+BOUND_WORK = {(): "whole_over_floor_bound", ("summary_work_s",): "whole_over_floor_summary_bound",
+              ("summary_work_s", "event_work_s"): "whole_over_floor_events_bound"}
+
+
+def whole_over_floor_bound(rows, entry, peers=floor.PEERS, levels=workprecision.ERROR_LEVELS, work=()):
+    """The whole / floor a run would reach if it spent no time outside its integrator calls and the
+    ``work`` named.
 
     Per peer: the peer's whole-run time over IDAS's time inside its integrator calls
-    (``integration_time_s``; plus ``summary_work_s`` with ``with_summary``) at matched error, averaged
-    over the error levels as ``speedup_vs_<peer>`` is (:func:`~clutchocp.bench.workprecision.headline`),
+    (``integration_time_s``) plus the ``work`` (row keys [s]) at matched error, averaged over the
+    error levels as ``speedup_vs_<peer>`` is (:func:`~clutchocp.bench.workprecision.headline`),
     divided by ``floor_speedup_vs_<peer>``. The calls of a whole run start and stop where its events
     are found (it cannot know an event before integrating past it), so they cost more than the floor's
-    one call per mode piece; the bound is what whole / floor could reach by cutting the output grid,
-    the summary and the other work between the calls, with the calls unchanged. The summary work
-    (the outputs the summary reads and the summary: :mod:`~clutchocp.bench.summary_work`) is paid by
-    the peers' whole runs as well; ``with_summary`` keeps it, so the bound is what a hybrid loop that
-    cost nothing (event detection, location, restarts and bookkeeping) would reach with the calls as
-    they are, and moving where the calls start and stop moves IDAS's steps, so its results.
+    one call per mode piece, and moving where they start and stop moves IDAS's steps, so its results.
+    With ``work=()`` the bound is what whole / floor could reach by cutting everything between the
+    calls. The summary work (``summary_work_s``: the outputs the summary reads and the summary,
+    :mod:`~clutchocp.bench.summary_work`) is paid by the peers' whole runs as well, and the event work
+    (``event_work_s``: the event functions on the samples the run keeps,
+    :mod:`~clutchocp.bench.event_work`) by any run that finds its events on its output grid; with
+    both, the bound is what a hybrid loop that cost nothing else (event location, restarts and
+    bookkeeping) would reach with the calls as they are.
 
     Parameters
     ----------
     rows : list of dict
         The work-precision rows of one scene (``method``, ``status``, ``error``, ``wall_time_s``,
-        ``integration_time_s``, for IDAS ``summary_work_s`` [s]).
+        ``integration_time_s``, for IDAS ``summary_work_s`` and ``event_work_s`` [s]).
     entry : dict
         The scene's summary entry, with ``floor_speedup_vs_<peer>``.
     peers : sequence of str
         The floor's peers.
     levels : sequence of float
         The matched error levels (those of ``speedup_vs_<peer>``).
-    with_summary : bool
-        Count IDAS's summary work with its integrator calls.
+    work : tuple of str
+        A key of :data:`BOUND_WORK`: the work counted with IDAS's integrator calls.
 
     Returns
     -------
     dict
-        ``{whole_over_floor_bound_vs_<peer>: float or None}``, with ``with_summary``
-        ``{whole_over_floor_summary_bound_vs_<peer>: ...}`` (None where a ratio is missing).
+        ``{<BOUND_WORK[work]>_vs_<peer>: float or None}`` (None where a ratio is missing).
     """
-    name, idas_key = "whole_over_floor_bound", "integration_time_s"
-    if with_summary:
-        name, idas_key = "whole_over_floor_summary_bound", "calls_and_summary_s"
-        rows = [{**r, idas_key: r["integration_time_s"] + r["summary_work_s"]}
-                if r["method"] == "idas" and r.get("status") == "ok" else r for r in rows]
+    name, idas_key = BOUND_WORK[tuple(work)], "calls_and_work_s"
+    rows = [{**r, idas_key: r["integration_time_s"] + sum(r[k] for k in work)}
+            if r["method"] == "idas" and r.get("status") == "ok" else r for r in rows]
     ratios = workprecision.speedups(rows, peers=peers, levels=levels, key="wall_time_s", idas_key=idas_key)
     out = {}
     for peer, by_level in ratios.items():
@@ -297,7 +302,9 @@ def format_summary(summary):
                      f"integrator calls: Radau {num(e.get('whole_over_floor_bound_vs_radau'))}, "
                      f"LSODA {num(e.get('whole_over_floor_bound_vs_lsoda'))}; with the summary work too: "
                      f"Radau {num(e.get('whole_over_floor_summary_bound_vs_radau'))}, "
-                     f"LSODA {num(e.get('whole_over_floor_summary_bound_vs_lsoda'))})")
+                     f"LSODA {num(e.get('whole_over_floor_summary_bound_vs_lsoda'))}; and the event checks: "
+                     f"Radau {num(e.get('whole_over_floor_events_bound_vs_radau'))}, "
+                     f"LSODA {num(e.get('whole_over_floor_events_bound_vs_lsoda'))})")
         lines.append(f"    run time ~ pairs^{e['scaling_exponent_pairs']:.2f}; stiffness ratio up to "
                      f"{num(stiff['max_stiffness_ratio'], '{:.3g}')}, fastest time constant "
                      f"{num(stiff['min_time_constant_s'], '{:.3g}')} s")

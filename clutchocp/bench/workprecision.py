@@ -22,8 +22,10 @@ Wall times are of the whole ``simulate_engagement`` call (integration, event loc
 summary) with the model built and its integrators cached by an untimed warm-up run; the best of
 ``repeats`` runs counts. An IDAS row also gets the time of its run's summary work (the outputs its
 summary reads, evaluated afresh, and the summary: :mod:`clutchocp.bench.summary_work`), which
-every whole run pays whatever integrates it. Times at matched error come from the Pareto front of each method's
-(error, time) points, interpolated in log-log (:func:`time_at_error`).
+every whole run pays whatever integrates it, and of its event work (its modes' event functions on
+the samples it keeps: :mod:`clutchocp.bench.event_work`), which the floor, knowing its events,
+skips. Times at matched error come from the Pareto front of each method's (error, time) points,
+interpolated in log-log (:func:`time_at_error`).
 """
 
 import itertools
@@ -36,6 +38,7 @@ from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..errors import ClutchocpError, ModelError
 from ..output import new_figure, save_figure, write_csv
+from .event_work import event_work_time
 from .summary_work import summary_time
 
 METHODS = ("idas", "idas-native", "cvodes", "Radau", "BDF", "LSODA")
@@ -211,6 +214,7 @@ def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=
             stats = run.summary["solver"]["statistics"]
             if method == "idas":        # before the errors read more outputs
                 row["summary_work_s"] = summary_time(run, count)[0]
+                row["event_work_s"] = event_work_time(run, count)
             errors = trajectory_errors(run, reference)
             row.update(status="ok", wall_time_s=wall, cpu_time_s=cpu, error=errors["max"],
                        integration_time_s=stats.get("integration_time_s"),
@@ -298,7 +302,7 @@ def headline(ratios):
 
 
 SWEEP_COLUMNS = ("scene", "method", "rtol", "atol", "status", "wall_time_s", "cpu_time_s", "integration_time_s",
-                 "summary_work_s", "error", *(f"error_{k}" for k in ERROR_PARTS), "engagement_time_s", "n_steps", "n_rhs_evals",
+                 "summary_work_s", "event_work_s", "error", *(f"error_{k}" for k in ERROR_PARTS), "engagement_time_s", "n_steps", "n_rhs_evals",
                  "n_jacobian_evals")
 
 

@@ -104,12 +104,32 @@ def test_summary_bound_adds_idas_summary_work_to_its_integrator_calls():
     entry = {"floor_speedup_vs_radau": 40.0}
     # by hand, at the log-midpoints 1e-5 and 1e-7: IDAS's calls plus summary work sqrt(2.5 * 4) and
     # sqrt(4 * 6), Radau's wall time 20 and 80: sqrt(20 * 80 / sqrt(10 * 24)) / 40
-    bound = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7), with_summary=True)
+    bound = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
+                                             work=("summary_work_s",))
     assert bound["whole_over_floor_summary_bound_vs_radau"] == pytest.approx(
         math.sqrt(20.0 * 80.0 / math.sqrt(240.0)) / 40.0, rel=1e-12)
     calls_only = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7))
     assert bound["whole_over_floor_summary_bound_vs_radau"] < calls_only["whole_over_floor_bound_vs_radau"]
-    assert "calls_and_summary_s" not in rows[0]                     # the rows are left as they were
+    assert "calls_and_work_s" not in rows[0]                        # the rows are left as they were
+
+
+def test_events_bound_adds_idas_event_work_to_its_calls_and_summary_work():
+    rows = _rows({"idas": [(1e-4, 2.0, 1.0), (1e-6, 4.0, 2.5), (1e-8, 8.0, 4.0)],
+                  "Radau": [(1e-4, 10.0, 9.0), (1e-6, 40.0, 30.0), (1e-8, 160.0, 150.0)]})
+    for row, work, events in zip(rows, (1.5, 1.5, 2.0, 9.0, 9.0, 9.0), (0.5, 0.5, 1.0, 9.0, 9.0, 9.0)):
+        row["summary_work_s"], row["event_work_s"] = work, events
+    entry = {"floor_speedup_vs_radau": 40.0}
+    # by hand, at the log-midpoints 1e-5 and 1e-7: IDAS's calls, summary and event work sqrt(3 * 4.5)
+    # and sqrt(4.5 * 7), Radau's wall time 20 and 80: sqrt(20 * 80 / sqrt(13.5 * 31.5)) / 40
+    bound = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
+                                             work=("summary_work_s", "event_work_s"))
+    assert bound["whole_over_floor_events_bound_vs_radau"] == pytest.approx(
+        math.sqrt(20.0 * 80.0 / math.sqrt(13.5 * 31.5)) / 40.0, rel=1e-12)
+    summary_only = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
+                                                    work=("summary_work_s",))
+    assert bound["whole_over_floor_events_bound_vs_radau"] < summary_only["whole_over_floor_summary_bound_vs_radau"]
+    with pytest.raises(KeyError):                                   # only the bounds the bench reports
+        bench_run.whole_over_floor_bound(rows, entry, work=("event_work_s",))
 
 
 def test_timed_runs_per_point():
@@ -291,22 +311,28 @@ def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
         assert entry[key] is not None and entry[key] > 0
     assert written["scenes"]["zhang2021"].keys() >= {"whole_over_floor_vs_radau", "whole_over_floor_vs_lsoda"}
     assert entry["whole_over_floor_vs_radau"] == bench_run.whole_over_floor(entry)["whole_over_floor_vs_radau"]
-    for row in rows:     # IDAS's summary work is part of its run; the other methods' is not timed
+    for row in rows:     # IDAS's summary and event work are part of its run; the other methods' are not timed
         if row["method"] == "idas":
-            assert 0 < float(row["summary_work_s"]) < float(row["wall_time_s"]) - float(row["integration_time_s"])
+            outside = float(row["wall_time_s"]) - float(row["integration_time_s"])
+            assert 0 < float(row["event_work_s"]) < float(row["summary_work_s"]) < outside
         else:
-            assert row["summary_work_s"] == ""
+            assert row["summary_work_s"] == "" and row["event_work_s"] == ""
     rows_written = [{**r, "error": float(r["error"]), "wall_time_s": float(r["wall_time_s"]),
                      "integration_time_s": float(r["integration_time_s"]),
-                     "summary_work_s": float(r["summary_work_s"] or "nan")} for r in rows]
+                     "summary_work_s": float(r["summary_work_s"] or "nan"),
+                     "event_work_s": float(r["event_work_s"] or "nan")} for r in rows]
     for peer in ("radau", "lsoda"):       # the bound, recomputed from the written rows, is above whole / floor
         bound = bench_run.whole_over_floor_bound(rows_written, entry)[f"whole_over_floor_bound_vs_{peer}"]
         assert entry[f"whole_over_floor_bound_vs_{peer}"] == pytest.approx(bound, rel=1e-9)
         assert bound > entry[f"whole_over_floor_vs_{peer}"]      # integrator calls are part of the run
-        with_summary = bench_run.whole_over_floor_bound(rows_written, entry, with_summary=True)
+        with_summary = bench_run.whole_over_floor_bound(rows_written, entry, work=("summary_work_s",))
         key = f"whole_over_floor_summary_bound_vs_{peer}"
         assert entry[key] == pytest.approx(with_summary[key], rel=1e-9)
         assert entry[f"whole_over_floor_vs_{peer}"] < entry[key] < bound  # so is the summary work
+        with_events = bench_run.whole_over_floor_bound(rows_written, entry, work=("summary_work_s", "event_work_s"))
+        events_key = f"whole_over_floor_events_bound_vs_{peer}"
+        assert entry[events_key] == pytest.approx(with_events[events_key], rel=1e-9)
+        assert entry[f"whole_over_floor_vs_{peer}"] < entry[events_key] < entry[key]  # and the event checks
     assert written["single_run_s"] == {}          # bao2020 not among the scenes: not timed
     text = bench_run.format_summary(summary)
     assert "issue" not in text and "target" not in text and "integrator floor" in text

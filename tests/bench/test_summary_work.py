@@ -3,33 +3,23 @@ nothing the run evaluated is carried over."""
 
 import pytest
 
-from clutchocp.bench.summary_work import evaluators, summary_time, unevaluated
-from clutchocp.bench.workprecision import run_method
-from clutchocp.engagement.model import EngagementModel
+from clutchocp.bench.summary_work import summary_time, unevaluated
 from clutchocp.errors import ClutchocpError
-from clutchocp.scene import load_scene
 
 
 def _without_timing(summary):
     return {k: v for k, v in summary.items() if k not in ("wall_time_s", "solver")}   # solver: options, statistics
 
 
-@pytest.fixture(scope="module")
-def zhang():
-    scene = load_scene("zhang2021")
-    model = EngagementModel(scene)
-    return scene, model, run_method(scene, model, "idas", 1e-5)
-
-
-def test_summary_from_the_samples_alone_is_the_runs_own(zhang):
-    _, _, run = zhang
+def test_summary_from_the_samples_alone_is_the_runs_own(zhang_run):
+    _, _, run = zhang_run
     seconds, summary = summary_time(run, repeats=2)
     assert seconds > 0
     assert _without_timing(summary) == _without_timing(run.summary)
 
 
-def test_fresh_outputs_start_unevaluated_and_equal_the_runs(zhang):
-    _, _, run = zhang
+def test_fresh_outputs_start_unevaluated_and_equal_the_runs(zhang_run):
+    _, _, run = zhang_run
     fresh = unevaluated(run)
     assert all(not seg.outputs.evaluated() for seg in fresh.segments)
     for name in ("total_torque_Nm", "output_jerk_rad_s3", "film_1_fluid_force_N"):
@@ -37,11 +27,8 @@ def test_fresh_outputs_start_unevaluated_and_equal_the_runs(zhang):
     assert all(seg.outputs.evaluated() for seg in fresh.segments)
 
 
-def test_a_run_that_let_its_samples_go_needs_the_evaluators_taken_before(zhang):
-    scene, model, _ = zhang
-    run = run_method(scene, model, "idas", 1e-5)
-    kept = evaluators(run.result)
-    run.result.load(run.result.names())                # every output read: the samples are let go
+def test_a_run_that_let_its_samples_go_needs_the_evaluators_taken_before(zhang_run_let_go):
+    run, kept = zhang_run_let_go
     with pytest.raises(ClutchocpError, match="let its samples go"):
         unevaluated(run)
     assert _without_timing(summary_time(run, repeats=1, kept=kept)[1]) == _without_timing(run.summary)

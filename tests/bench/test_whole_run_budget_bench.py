@@ -49,17 +49,18 @@ def test_ideal_ratio_is_that_of_a_run_costing_its_floor_plus_the_summary_work():
     assert row["whole_over_floor"] < row["whole_over_floor_ideal"]
 
 
-def test_event_work_is_the_event_functions_on_the_samples_each_piece_keeps():
+def test_summary_and_event_work_are_timed_on_one_run_and_the_spy_is_removed():
+    import clutchocp.engagement.run as run_module
     from clutchocp.bench.workprecision import run_method
     from clutchocp.engagement.model import EngagementModel
     from clutchocp.scene import load_scene
 
     scene = load_scene("zhang2021")
     model = EngagementModel(scene)
-    inner = IdasPath.advance
-    seconds = _bench().event_work(scene, model, "idas", 1e-5, repeats=2)
-    assert IdasPath.advance is inner                                        # the spy is removed
-    assert 0 < seconds < run_method(scene, model, "idas", 1e-5).result.stats["wall_time_s"]
+    inner = run_module.summarize
+    work, events = _bench().summary_and_event_work(scene, model, "idas", 1e-5, repeats=2)
+    assert run_module.summarize is inner
+    assert 0 < events < work < run_method(scene, model, "idas", 1e-5).result.stats["wall_time_s"]
     (row,) = _bench().measure("zhang2021", [1e-5], repeats=1, engines=["vm"])
     calls, work, events = row["parts_ms"]["integrator_calls"], row["summary_work_ms"], row["event_work_ms"]
     assert row["whole_over_floor_calls_summary_events"] == pytest.approx(

@@ -132,18 +132,23 @@ def integrator_floor(reference, sweep_rows, methods=METHODS, repeats=3, progress
     model = reference.model
     parts = pieces(reference)
     name = model.scene.name
+    points = [r for r in sweep_rows if r["method"] in methods and r.get("status") == "ok"]
     rows = []
-    for method in methods:
-        for sweep_row in (r for r in sweep_rows if r["method"] == method and r.get("status") == "ok"):
-            row = {"scene": name, "method": method, "rtol": sweep_row["rtol"], "error": sweep_row["error"]}
+    # every method at one tolerance before the next (as the sweep): the floors a ratio divides are
+    # timed seconds apart, so a machine that slows down or speeds up moves both alike
+    for rtol in sorted({r["rtol"] for r in points}, reverse=True):
+        for sweep_row in (r for r in points if r["rtol"] == rtol):
+            row = {"scene": name, "method": sweep_row["method"], "rtol": rtol, "error": sweep_row["error"]}
             try:
-                t, err = floor_run(model, parts, method, sweep_row["rtol"], repeats)
+                t, err = floor_run(model, parts, sweep_row["method"], rtol, repeats)
                 row.update(status="ok", time_s=t, piece_end_error=err)
             except ClutchocpError as exc:
                 row.update(status=f"failed: {str(exc)[:200]}")
             rows.append(row)
-        if progress:
-            done = [r for r in rows if r["method"] == method and r["status"] == "ok"]
+    rows.sort(key=lambda r: (list(methods).index(r["method"]), -r["rtol"]))
+    for method in methods:
+        done = [r for r in rows if r["method"] == method and r["status"] == "ok"]
+        if progress and done:
             progress.note(f"{name} integrator floor, {method}: " + ", ".join(
                 f"{r['time_s'] * 1e3:.1f} ms at rtol {r['rtol']:.0e}" for r in done[::2]))
     summary = {"n_pieces": len(parts), "rows": rows}

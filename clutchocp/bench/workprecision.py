@@ -162,6 +162,11 @@ def timed_runs(method, repeats, least_repeats=None):
 def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=None, model=None, least_repeats=None):
     """Every method over the tolerance sweep on one scene, against the reference.
 
+    After one warm-up run of each method, the methods are timed in turn at each tolerance (all of
+    them at the loosest, then at the next): the times a speed-up divides are taken seconds apart,
+    not minutes, so a machine that slows down or speeds up during the sweep moves them alike. The
+    rows come out by method, then tolerance.
+
     Parameters
     ----------
     scene : clutchocp.scene.Scene
@@ -188,7 +193,7 @@ def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=
         err = confirmation["errors"]["max"] if confirmation.get("errors") else math.nan
         progress.step(f"{scene.name}: reference IDAS rtol {REFERENCE_RTOL:g} ({ref_stats['n_steps']} steps), "
                       f"{CONFIRM_METHOD} rtol {CONFIRM_RTOL:g} within {err:.1e}")
-    rows = []
+    rows, ready = [], []
     for method in methods:
         try:
             run_method(scene, model, method, tolerances[0])                   # warm-up: builds, caches
@@ -199,38 +204,48 @@ def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=
             continue
         except ClutchocpError:
             pass
-        for rtol in tolerances:
-            row = {"scene": scene.name, "method": method, "rtol": rtol, "atol": rtol * ATOL_RATIO}
-            start = time.perf_counter()
-            try:
-                count = timed_runs(method, repeats, least_repeats)
-                wall, cpu, run = timed_run(scene, model, method, rtol, count)
-            except ClutchocpError as exc:   # e.g. scipy BDF's step size collapsing at the impact
-                row.update(status=f"failed: {str(exc)[:200]}", wall_time_s=time.perf_counter() - start)
-                rows.append(row)
-                if progress:
-                    progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: FAILED ({str(exc)[:70]}...)")
-                continue
-            stats = run.summary["solver"]["statistics"]
-            if method == "idas":        # before the errors read more outputs
-                row["summary_work_s"] = summary_time(run, count)[0]
-                row["event_work_s"] = event_work_time(run, count)
-            errors = trajectory_errors(run, reference)
-            row.update(status="ok", wall_time_s=wall, cpu_time_s=cpu, error=errors["max"],
-                       integration_time_s=stats.get("integration_time_s"),
-                       **{f"error_{k}": errors[k] for k in ERROR_PARTS},
-                       engagement_time_s=run.summary["engagement_time_s"],
-                       n_steps=stats.get("n_steps"), n_rhs_evals=stats.get("n_rhs_evals", 0),
-                       n_jacobian_evals=stats.get("n_jacobian_evals", 0))
-            rows.append(row)
-            if progress:
-                progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: {wall * 1e3:8.1f} ms, error {errors['max']:.1e}")
+        ready.append(method)
+    # every method at one tolerance before the next tolerance: a peer's time and IDAS's are taken
+    # seconds apart, so a machine that slows down or speeds up during the sweep moves both alike
+    for rtol in tolerances:
+        for method in ready:
+            rows.append(_point(scene, model, reference, method, rtol, repeats, least_repeats, progress))
+    order = {method: i for i, method in enumerate(methods)}
+    rows.sort(key=lambda row: (order[row["method"]], tolerances.index(row["rtol"])))
     return {"scene": scene.name,
             "reference": {"method": "idas", "rtol": REFERENCE_RTOL, "atol": REFERENCE_RTOL * ATOL_RATIO,
                           "engagement_time_s": reference.summary["engagement_time_s"],
                           "lockup_torque_jump_Nm": reference.summary["lockup_torque_jump_Nm"],
                           "n_steps": ref_stats.get("n_steps"), "wall_time_s": reference.summary["wall_time_s"]},
             "confirmation": confirmation, "rows": rows, "reference_run": reference}
+
+
+def _point(scene, model, reference, method, rtol, repeats, least_repeats, progress):
+    """One row of :func:`sweep`: ``method`` at ``rtol``, timed, and its errors against ``reference``."""
+    row = {"scene": scene.name, "method": method, "rtol": rtol, "atol": rtol * ATOL_RATIO}
+    start = time.perf_counter()
+    try:
+        count = timed_runs(method, repeats, least_repeats)
+        wall, cpu, run = timed_run(scene, model, method, rtol, count)
+    except ClutchocpError as exc:   # e.g. scipy BDF's step size collapsing at the impact
+        row.update(status=f"failed: {str(exc)[:200]}", wall_time_s=time.perf_counter() - start)
+        if progress:
+            progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: FAILED ({str(exc)[:70]}...)")
+        return row
+    stats = run.summary["solver"]["statistics"]
+    if method == "idas":        # before the errors read more outputs
+        row["summary_work_s"] = summary_time(run, count)[0]
+        row["event_work_s"] = event_work_time(run, count)
+    errors = trajectory_errors(run, reference)
+    row.update(status="ok", wall_time_s=wall, cpu_time_s=cpu, error=errors["max"],
+               integration_time_s=stats.get("integration_time_s"),
+               **{f"error_{k}": errors[k] for k in ERROR_PARTS},
+               engagement_time_s=run.summary["engagement_time_s"],
+               n_steps=stats.get("n_steps"), n_rhs_evals=stats.get("n_rhs_evals", 0),
+               n_jacobian_evals=stats.get("n_jacobian_evals", 0))
+    if progress:
+        progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: {wall * 1e3:8.1f} ms, error {errors['max']:.1e}")
+    return row
 
 
 def pareto_front(points):

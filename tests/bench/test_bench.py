@@ -337,3 +337,54 @@ def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
     text = bench_run.format_summary(summary)
     assert "issue" not in text and "target" not in text and "integrator floor" in text
     assert "no time outside the integrator calls" in text
+
+
+def test_sweep_times_every_method_at_one_tolerance_before_the_next(monkeypatch):
+    # the timed runs are recorded in the order they are made; a method whose warm-up says it does
+    # not apply gets its rows without being timed, the others are timed in turn at each tolerance
+    timed = []
+
+    class Run:
+        summary = {"solver": {"statistics": {"integration_time_s": 1e-3, "n_steps": 10}}, "engagement_time_s": 0.1,
+                   "lockup_torque_jump_Nm": -1.0, "wall_time_s": 1e-2}
+
+    def warm_up(scene, model, method, rtol, **options):
+        if method == "cvodes":
+            raise ModelError("mode 'x' has algebraic variables")
+
+    def timed_run(scene, model, method, rtol, repeats=1, **options):
+        timed.append((method, rtol))
+        return 2e-3, 2e-3, Run()
+
+    monkeypatch.setattr(wp, "reference_runs", lambda scene, model: (Run(), {}))
+    monkeypatch.setattr(wp, "run_method", warm_up)
+    monkeypatch.setattr(wp, "timed_run", timed_run)
+    monkeypatch.setattr(wp, "summary_time", lambda run, count: (1e-4, None))
+    monkeypatch.setattr(wp, "event_work_time", lambda run, count: 1e-5)
+    monkeypatch.setattr(wp, "trajectory_errors", lambda run, reference: dict.fromkeys(("max", *wp.ERROR_PARTS), 1e-6))
+    scene = load_scene("zhang2021")
+    methods, tolerances = ("idas", "cvodes", "Radau", "LSODA"), (1e-4, 1e-6, 1e-8)
+    res = wp.sweep(scene, methods=methods, tolerances=tolerances, model=object())
+    assert timed == [(m, r) for r in tolerances for m in ("idas", "Radau", "LSODA")]
+    assert [(row["method"], row["rtol"]) for row in res["rows"]] == [(m, r) for m in methods for r in tolerances]
+    assert all(row["status"].startswith("n/a") for row in res["rows"] if row["method"] == "cvodes")
+    assert all(row["event_work_s"] == 1e-5 for row in res["rows"] if row["method"] == "idas")
+
+
+def test_floor_times_every_method_at_one_tolerance_before_the_next(monkeypatch):
+    timed = []
+
+    def floor_run(model, parts, method, rtol, repeats=3, native=False):
+        timed.append((method, rtol))
+        return 1e-3, 1e-9
+
+    class Reference:
+        model = type("Model", (), {"scene": type("Scene", (), {"name": "s"})()})()
+
+    monkeypatch.setattr(floor, "pieces", lambda reference: [])
+    monkeypatch.setattr(floor, "floor_run", floor_run)
+    sweep_rows = [{"method": m, "rtol": r, "status": "ok", "error": r} for m in ("idas", "BDF", "Radau", "LSODA")
+                  for r in (1e-4, 1e-6)]
+    low = floor.integrator_floor(Reference(), sweep_rows)
+    assert timed == [(m, r) for r in (1e-4, 1e-6) for m in ("idas", "Radau", "LSODA")]
+    assert [(row["method"], row["rtol"]) for row in low["rows"]] == [(m, r) for m in floor.METHODS for r in (1e-4, 1e-6)]

@@ -162,10 +162,10 @@ def timed_runs(method, repeats, least_repeats=None):
 def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=None, model=None, least_repeats=None):
     """Every method over the tolerance sweep on one scene, against the reference.
 
-    After one warm-up run of each method, the methods are timed in turn at each tolerance (all of
-    them at the loosest, then at the next): the times a speed-up divides are taken seconds apart,
-    not minutes, so a machine that slows down or speeds up during the sweep moves them alike. The
-    rows come out by method, then tolerance.
+    After one warm-up run of each method, the methods take turns at each tolerance (all of them at
+    the loosest, then at the next), one timed run each per round: the times a speed-up divides are
+    taken side by side, so a machine that slows down for a while slows them alike, and the best
+    run of each comes from its fastest stretch. The rows come out by method, then tolerance.
 
     Parameters
     ----------
@@ -205,11 +205,8 @@ def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=
         except ClutchocpError:
             pass
         ready.append(method)
-    # every method at one tolerance before the next tolerance: a peer's time and IDAS's are taken
-    # seconds apart, so a machine that slows down or speeds up during the sweep moves both alike
     for rtol in tolerances:
-        for method in ready:
-            rows.append(_point(scene, model, reference, method, rtol, repeats, least_repeats, progress))
+        rows += _points(scene, model, reference, ready, rtol, repeats, least_repeats, progress)
     order = {method: i for i, method in enumerate(methods)}
     rows.sort(key=lambda row: (order[row["method"]], tolerances.index(row["rtol"])))
     return {"scene": scene.name,
@@ -220,32 +217,49 @@ def sweep(scene, *, methods=METHODS, tolerances=TOLERANCES, repeats=3, progress=
             "confirmation": confirmation, "rows": rows, "reference_run": reference}
 
 
-def _point(scene, model, reference, method, rtol, repeats, least_repeats, progress):
-    """One row of :func:`sweep`: ``method`` at ``rtol``, timed, and its errors against ``reference``."""
-    row = {"scene": scene.name, "method": method, "rtol": rtol, "atol": rtol * ATOL_RATIO}
-    start = time.perf_counter()
-    try:
-        count = timed_runs(method, repeats, least_repeats)
-        wall, cpu, run = timed_run(scene, model, method, rtol, count)
-    except ClutchocpError as exc:   # e.g. scipy BDF's step size collapsing at the impact
-        row.update(status=f"failed: {str(exc)[:200]}", wall_time_s=time.perf_counter() - start)
+def _points(scene, model, reference, methods, rtol, repeats, least_repeats, progress):
+    """The rows of :func:`sweep` at ``rtol``: the methods take turns, one timed run each per round,
+    until each has had its :func:`timed_runs` (the best wall time, and its run, counts; the best CPU
+    time apart), then each row gets its errors against ``reference``."""
+    counts = {method: timed_runs(method, repeats, least_repeats) for method in methods}
+    best = dict.fromkeys(methods, (math.inf, math.inf, None))
+    failed = {}
+    for attempt in range(max(counts.values(), default=0)):
+        for method in (m for m in methods if attempt < counts[m] and m not in failed):
+            start = time.perf_counter()
+            try:
+                wall, cpu, run = timed_run(scene, model, method, rtol)
+            except ClutchocpError as exc:   # e.g. scipy BDF's step size collapsing at the impact
+                failed[method] = (exc, time.perf_counter() - start)
+                continue
+            best_wall, best_cpu, best_run = best[method]
+            best[method] = (wall, min(cpu, best_cpu), run) if wall < best_wall else (best_wall, min(cpu, best_cpu), best_run)
+    rows = []
+    for method in methods:
+        row = {"scene": scene.name, "method": method, "rtol": rtol, "atol": rtol * ATOL_RATIO}
+        if method in failed:
+            exc, elapsed = failed[method]
+            row.update(status=f"failed: {str(exc)[:200]}", wall_time_s=elapsed)
+            if progress:
+                progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: FAILED ({str(exc)[:70]}...)")
+            rows.append(row)
+            continue
+        wall, cpu, run = best[method]
+        stats = run.summary["solver"]["statistics"]
+        if method == "idas":        # before the errors read more outputs
+            row["summary_work_s"] = summary_time(run, counts[method])[0]
+            row["event_work_s"] = event_work_time(run, counts[method])
+        errors = trajectory_errors(run, reference)
+        row.update(status="ok", wall_time_s=wall, cpu_time_s=cpu, error=errors["max"],
+                   integration_time_s=stats.get("integration_time_s"),
+                   **{f"error_{k}": errors[k] for k in ERROR_PARTS},
+                   engagement_time_s=run.summary["engagement_time_s"],
+                   n_steps=stats.get("n_steps"), n_rhs_evals=stats.get("n_rhs_evals", 0),
+                   n_jacobian_evals=stats.get("n_jacobian_evals", 0))
+        rows.append(row)
         if progress:
-            progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: FAILED ({str(exc)[:70]}...)")
-        return row
-    stats = run.summary["solver"]["statistics"]
-    if method == "idas":        # before the errors read more outputs
-        row["summary_work_s"] = summary_time(run, count)[0]
-        row["event_work_s"] = event_work_time(run, count)
-    errors = trajectory_errors(run, reference)
-    row.update(status="ok", wall_time_s=wall, cpu_time_s=cpu, error=errors["max"],
-               integration_time_s=stats.get("integration_time_s"),
-               **{f"error_{k}": errors[k] for k in ERROR_PARTS},
-               engagement_time_s=run.summary["engagement_time_s"],
-               n_steps=stats.get("n_steps"), n_rhs_evals=stats.get("n_rhs_evals", 0),
-               n_jacobian_evals=stats.get("n_jacobian_evals", 0))
-    if progress:
-        progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: {wall * 1e3:8.1f} ms, error {errors['max']:.1e}")
-    return row
+            progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: {wall * 1e3:8.1f} ms, error {errors['max']:.1e}")
+    return rows
 
 
 def pareto_front(points):

@@ -28,12 +28,14 @@ a run makes it (its start, parameters, normalised time and output grid) and time
 ``whole_ms`` is a whole run's best time (``--repeats`` runs), ``ended_saving_share`` the part of it
 an ended first call would save (``(full - ended) / whole``): with every other time unchanged,
 ``whole / floor`` would rise by the factor ``1 / (1 - share)``. Results go to
-``bench_first_call_stop.json`` in ``--out`` and a table to stdout.
+``bench_first_call_stop.json`` in ``--out`` and a table to stdout. The three calls and the whole run
+take turns, one timed call each per round, after one untimed call each
+(:func:`clutchocp.bench.turns.best_of_turns`): the times a saving divides are taken side by side.
 """
 
 import argparse
+import functools
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -77,32 +79,37 @@ def delayed_events(cm, lag_tau):
     return ca.substitute(s - lag_tau * span * slope, cm.t, t0 + tau * span)
 
 
-def timed_call(integrator, nx, nz, n, x0, z0, p, repeats):
-    """Best time [s] of ``repeats`` buffer calls, the scaled states (nx, n) (NaN where the call wrote
-    none), its step count and its error message ('' if none)."""
+def call_task(integrator, nx, nz, n, x0, z0, p):
+    """A task (:func:`clutchocp.bench.turns.best_of_turns`) of one buffer call of ``integrator``: its time
+    [s] and (the scaled states (nx, n), NaN where the call wrote none; its step count; its error
+    message, '' if none)."""
     buffer, evaluate = integrator.buffer()
     dummy = np.zeros(1)
-    best, message = math.inf, ""
-    for _ in range(repeats):
+
+    def task():
         xf, zf = np.full((n, nx), np.nan), np.zeros((n, max(nz, 1)))
         for i, a in enumerate((x0, z0, p)):
             buffer.set_arg(i, memoryview(a if a.size else dummy))
         buffer.set_res(0, memoryview(xf))
         buffer.set_res(1, memoryview(zf if nz else dummy))
+        message = ""
         start = time.perf_counter()
         try:
             evaluate()
         except RuntimeError as err:
             message = str(err).strip().splitlines()[-1]
-        best = min(best, time.perf_counter() - start)
-    return best, xf.T, int(buffer.stats().get("nsteps", 0)), message
+        seconds = time.perf_counter() - start
+        return seconds, (xf.T, int(buffer.stats().get("nsteps", 0)), message)
+
+    return task
 
 
 def measure(name, rtol, past, repeats):
     """One scene: a JSON-ready row."""
     import casadi as ca
 
-    from clutchocp.bench.workprecision import timed_run
+    from clutchocp.bench.turns import best_of_turns, wall
+    from clutchocp.bench.workprecision import run_method
     from clutchocp.engagement.model import EngagementModel
     from clutchocp.scene import load_scene
 
@@ -119,22 +126,28 @@ def measure(name, rtol, past, repeats):
     p = np.concatenate([pu, [t0, span]])
     x0, z0 = np.ascontiguousarray(xs0).ravel(), np.ascontiguousarray(zs0).ravel()
 
-    def call(dae, grid, extra=None):
+    def task(dae, grid, extra=None):
         integrator = ca.integrator(f"{plugin}_{cm.name}", plugin, dae, 0.0, list(grid), {**options, **(extra or {})})
-        return timed_call(integrator, cm.nx, cm.nz, len(grid), x0, z0, p, repeats)
+        return call_task(integrator, cm.nx, cm.nz, len(grid), x0, z0, p)
 
-    full_s, full_x, full_steps, _ = call(cm.dae_tau, taus)
+    full_x = task(cm.dae_tau, taus)()[1][0]
     while True:     # a call's last steps shorten to land on its end (its stop time): end far enough past the event
-        ended_s, ended_x, ended_steps, _ = call(cm.dae_tau, taus[:min(n, before + past)])
+        ended_x = task(cm.dae_tau, taus[:min(n, before + past)])()[1][0]
         change = float(np.max(np.abs(ended_x[:, :before] - full_x[:, :before])))
         if change == 0.0 or before + past >= n:
             break
         past *= 2
     zero_dae = {**cm.dae_tau, "zero": delayed_events(cm, past / n)}
-    zero_s, zero_x, zero_steps, zero_message = call(zero_dae, taus, {"max_events": 0})
+    # the three calls and a whole run take turns, one timed call each per round
+    best = best_of_turns({"full": task(cm.dae_tau, taus), "ended": task(cm.dae_tau, taus[:min(n, before + past)]),
+                          "zero": task(zero_dae, taus, {"max_events": 0}),
+                          "whole": wall(functools.partial(run_method, scene, model, "idas", rtol))}, repeats)
+    full_s, (full_x, full_steps, _) = best["full"]
+    ended_s, (ended_x, ended_steps, _) = best["ended"]
+    zero_s, (zero_x, zero_steps, zero_message) = best["zero"]
+    whole = best["whole"][0]
     written = int(np.argmax(np.isnan(zero_x[0]))) if np.isnan(zero_x[0]).any() else n
     kept = min(before, written)
-    whole = timed_run(scene, model, "idas", rtol, repeats=repeats)[0]
     return {
         "scene": name, "rtol": rtol, "mode": cm.name, "event_t_s": float(event.t), "piece_end_s": float(times[-1]),
         "outputs": n, "outputs_before_event": before, "past": past,

@@ -10,8 +10,11 @@ Radau times ``R``. At one tolerance, ``whole / floor >= TARGET`` allows an IDAS 
 ``T_floor x R_whole / (TARGET x R_floor)``: the *budget* (the bench takes the ratios at matched
 error, averaged over error levels; here they are taken at equal rtol, one tolerance at a time).
 
-The whole run's time (the best of ``--repeats`` runs, wall clock, the model built and its
-integrators cached by untimed runs) is split with timers around:
+At each tolerance the times a ratio divides are taken side by side: Radau's whole run and floor
+pass, and per engine IDAS's plain run, floor pass and a run with timers take turns, one timed call
+each per round (Radau in the first third of the ``--repeats`` rounds, at least 3), after one untimed
+call each; the best of each counts (:func:`clutchocp.bench.turns.best_of_turns`). The timed run's
+time (wall clock) is split with timers around:
 
 * ``integrator_calls``: the IDAS/CVODES calls (``IdasPath._run``); ``integrator_excess_ms`` is their
   time beyond the floor's (the calls start and stop where the run finds its events);
@@ -47,7 +50,6 @@ equations). Results go to ``bench_whole_run_budget.json`` in ``--out`` and a tab
 import argparse
 import functools
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -162,43 +164,39 @@ def summary_and_event_work(scene, model, method, rtol, repeats):
     return summary_time(run, repeats, kept=kept[0])[0], event_work_time(run, repeats, kept=kept[0])
 
 
-def whole_run_parts(scene, model, method, rtol, repeats):
-    """The fastest of ``repeats`` timed runs (after two untimed ones): its time [s] and its parts [s]."""
+def parts_task(scene, model, method, rtol):
+    """A task (:func:`clutchocp.bench.turns.best_of_turns`) of one run with :class:`PartTimers` installed
+    around it alone: its wall time [s] and its parts [s] (``integrator_calls``, ``grid_evaluations``,
+    ``summary``, ``loop``)."""
     from clutchocp.bench.workprecision import run_method
 
-    for _ in range(2):
-        run_method(scene, model, method, rtol)
-    timers = PartTimers()
-    best = (math.inf, None)
-    try:
-        for _ in range(repeats):
-            timers.parts = {}
+    def task():
+        timers = PartTimers()
+        try:
             start = time.perf_counter()
             run_method(scene, model, method, rtol)
-            elapsed = time.perf_counter() - start
-            if elapsed < best[0]:
-                best = (elapsed, dict(timers.parts))
-    finally:
-        timers.remove()
-    whole, parts = best
-    summary = parts.get("summary_total", 0.0) - parts.get("summary_evaluations", 0.0)
-    named = {"integrator_calls": parts.get("integrator_calls", 0.0),
-             "grid_evaluations": parts.get("grid_evaluations", 0.0), "summary": summary}
-    named["loop"] = whole - sum(named.values())
-    return whole, named
+            whole = time.perf_counter() - start
+        finally:
+            timers.remove()
+        parts = timers.parts
+        summary = parts.get("summary_total", 0.0) - parts.get("summary_evaluations", 0.0)
+        named = {"integrator_calls": parts.get("integrator_calls", 0.0),
+                 "grid_evaluations": parts.get("grid_evaluations", 0.0), "summary": summary}
+        named["loop"] = whole - sum(named.values())
+        return whole, named
 
-
-def plain_time(scene, model, method, rtol, repeats):
-    """Best wall time [s] of ``repeats`` runs without timers (after two untimed ones)."""
-    from clutchocp.bench.workprecision import timed_run
-
-    timed_run(scene, model, method, rtol, repeats=2)
-    return timed_run(scene, model, method, rtol, repeats=repeats)[0]
+    return task
 
 
 def measure(name, rtols, repeats, engines):
-    """One scene: JSON-ready rows, one per (engine, rtol)."""
+    """One scene: JSON-ready rows, one per (engine, rtol).
+
+    At each tolerance the runs and floor passes take turns (:func:`clutchocp.bench.turns.best_of_turns`):
+    one timed call of each per round, Radau's whole run and floor in the first third of the rounds
+    (at least 3), each IDAS engine's plain run, floor pass and run split by timers in all of them;
+    the best of each counts. The summary and event work are timed afterwards on one run."""
     from clutchocp.bench import floor
+    from clutchocp.bench.turns import best_of_turns, wall
     from clutchocp.bench.workprecision import REFERENCE_RTOL, run_method
     from clutchocp.engagement.model import EngagementModel
     from clutchocp.scene import load_scene
@@ -208,13 +206,23 @@ def measure(name, rtols, repeats, engines):
     parts = floor.pieces(run_method(scene, model, "idas", REFERENCE_RTOL))
     rows = []
     for rtol in rtols:
-        r_whole = plain_time(scene, model, "Radau", rtol, max(3, repeats // 3))
-        r_floor = floor.floor_run(model, parts, "Radau", rtol, repeats=max(3, repeats // 3))[0]
+        radau_path = floor.floor_path(model, "Radau", rtol)
+        tasks = {"radau_whole": wall(functools.partial(run_method, scene, model, "Radau", rtol)),
+                 "radau_floor": functools.partial(floor.floor_pass, model, parts, "Radau", rtol, radau_path)}
+        counts = {"radau_whole": max(3, repeats // 3), "radau_floor": max(3, repeats // 3)}
         for engine in engines:
             method = "idas-native" if engine == "native" else "idas"
-            t_whole = plain_time(scene, model, method, rtol, repeats)
-            t_floor = floor.floor_run(model, parts, "idas", rtol, repeats=repeats, native=engine == "native")[0]
-            timed_whole, split = whole_run_parts(scene, model, method, rtol, repeats)
+            path = floor.floor_path(model, "idas", rtol, native=engine == "native")
+            tasks.update({f"{engine}_whole": wall(functools.partial(run_method, scene, model, method, rtol)),
+                          f"{engine}_floor": functools.partial(floor.floor_pass, model, parts, "idas", rtol, path),
+                          f"{engine}_parts": parts_task(scene, model, method, rtol)})
+            counts.update(dict.fromkeys((f"{engine}_whole", f"{engine}_floor", f"{engine}_parts"), repeats))
+        best = best_of_turns(tasks, counts)
+        r_whole, r_floor = best["radau_whole"][0], best["radau_floor"][0]
+        for engine in engines:
+            method = "idas-native" if engine == "native" else "idas"
+            t_whole, t_floor = best[f"{engine}_whole"][0], best[f"{engine}_floor"][0]
+            timed_whole, split = best[f"{engine}_parts"]
             allowed = budget(t_floor, r_whole, r_floor)
             work, events = summary_and_event_work(scene, model, method, rtol, repeats)
             rows.append({

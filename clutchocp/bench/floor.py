@@ -117,7 +117,7 @@ def floor_pass(model, parts, method, rtol, path):
     return total, worst
 
 
-def integrator_floor(reference, sweep_rows, methods=METHODS, repeats=3, progress=None):
+def integrator_floor(reference, sweep_rows, methods=METHODS, repeats=3, progress=None, least_repeats=None):
     """The floor of every (method, rtol) point of a work-precision sweep on one scene.
 
     Each point keeps the error its whole run reached in the sweep (the floor integrates the same
@@ -132,6 +132,9 @@ def integrator_floor(reference, sweep_rows, methods=METHODS, repeats=3, progress
     methods : sequence of str
     repeats : int
         Timed passes per point (the best counts).
+    least_repeats : dict, optional
+        ``{method: n}``: at least ``n`` timed passes per point for these methods (e.g. IDAS, whose
+        passes are short and noisy).
     progress : clutchocp.bench.progress.Progress, optional
 
     Returns
@@ -163,7 +166,8 @@ def integrator_floor(reference, sweep_rows, methods=METHODS, repeats=3, progress
         ok = [row for row in at if row["status"] == "ok"]
         best = best_of_turns({row["method"]: functools.partial(floor_pass, model, parts, row["method"], rtol,
                                                                paths[row["method"]]) for row in ok},
-                             repeats, warm_up=False)
+                             {row["method"]: max(repeats, (least_repeats or {}).get(row["method"], 1)) for row in ok},
+                             warm_up=False)
         for row in ok:
             row["time_s"], row["piece_end_error"] = best[row["method"]]
         rows += at

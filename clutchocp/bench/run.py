@@ -28,8 +28,12 @@
 * ``engagement_integrator_floor.csv`` -- the floor of every method and tolerance (also drawn,
   dashed, on the work-precision figure).
 
-``quick=True`` leaves out IDAS with native code, times single runs (three for the engine methods)
-and solves coarser optimisation meshes (about a minute on two cores).
+``quick=True`` leaves out IDAS with native code, times single runs (nine for the engine methods,
+three for the floor's peers) and solves coarser optimisation meshes (about ten minutes on two cores).
+In both modes every engine run and IDAS floor pass is timed at least ``engine_repeats`` (9) times:
+they take 5-25 ms, and with three IDAS's best at one point moved by up to 1.45x against Radau's
+between two quick benches, whole / floor by up to 0.18; with nine, two quick benches' whole /
+floor agreed within 0.02 on every scene.
 """
 
 import math
@@ -46,11 +50,14 @@ from . import floor, optimization, scaling, workprecision
 from .progress import Progress
 
 FULL = {"tolerances": workprecision.TOLERANCES, "methods": workprecision.METHODS, "repeats": 3,
-        "scaling_repeats": 3, "floor_repeats": 3}
+        "scaling_repeats": 3, "floor_repeats": 3, "engine_repeats": 9}
 # quick: single timings, but three of every run whole / floor is made of (the floor's peers' whole
-# runs and every floor point): a single timing of one of them moved it by up to 0.07 between runs
+# runs and every floor point): a single timing of one of them moved it by up to 0.07 between runs;
+# nine of the engine's runs and floor passes (5-25 ms each): with three, IDAS's best at one point
+# moved by up to 1.45x against Radau's between two runs, and whole / floor by up to 0.18
 QUICK = {"tolerances": workprecision.TOLERANCES, "methods": ("idas", "cvodes", "Radau", "BDF", "LSODA"),
-         "repeats": 1, "scaling_repeats": 1, "floor_repeats": 3}
+         "repeats": 1, "scaling_repeats": 1, "floor_repeats": 3, "engine_repeats": 9}
+ENGINE_METHODS = ("idas", "idas-native", "cvodes")
 SINGLE_RUN_SCENE = "bao2020"     # the scene of the single-run timing
 
 
@@ -73,7 +80,7 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
     out_dir : str or pathlib.Path
         Output folder (created).
     quick : bool
-        No native-code IDAS, single timed runs (three for the engine methods), coarser
+        No native-code IDAS, single timed runs (nine for the engine methods), coarser
         optimisation meshes.
     progress : bool
         A progress bar and one line per step on stderr.
@@ -98,9 +105,11 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
         model = EngagementModel(scene)
         res = workprecision.sweep(scene, methods=settings["methods"], tolerances=settings["tolerances"],
                                   repeats=settings["repeats"], progress=bar, model=model,
-                                  least_repeats={peer: settings["floor_repeats"] for peer in floor.PEERS})
+                                  least_repeats={**{peer: settings["floor_repeats"] for peer in floor.PEERS},
+                                                 **dict.fromkeys(ENGINE_METHODS, settings["engine_repeats"])})
         results.append(res)
-        low = floor.integrator_floor(res["reference_run"], res["rows"], repeats=settings["floor_repeats"], progress=bar)
+        low = floor.integrator_floor(res["reference_run"], res["rows"], repeats=settings["floor_repeats"], progress=bar,
+                                     least_repeats={"idas": settings["engine_repeats"]})
         floors[scene.name] = low.pop("rows")
         bar.step(f"{scene.name}: integrator floor {low['floor_speedup_vs_radau'] or math.nan:.1f}x over Radau, "
                  f"{low['floor_speedup_vs_lsoda'] or math.nan:.1f}x over LSODA")
@@ -131,6 +140,7 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
     summary = {"quick": quick, "scenes": per_scene, "optimization": opt_summary,
                "settings": {"tolerances": list(settings["tolerances"]), "methods": list(settings["methods"]),
                             "repeats": settings["repeats"], "floor_repeats": settings["floor_repeats"],
+                            "engine_repeats": settings["engine_repeats"],
                             "reference_rtol": workprecision.REFERENCE_RTOL,
                             "atol_over_rtol": workprecision.ATOL_RATIO,
                             "matched_error_levels": list(workprecision.ERROR_LEVELS)},

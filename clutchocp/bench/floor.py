@@ -150,9 +150,10 @@ def integrator_floor(reference, sweep_rows, methods=METHODS, repeats=3, progress
     name = model.scene.name
     points = [r for r in sweep_rows if r["method"] in methods and r.get("status") == "ok"]
     rows = []
-    # at each tolerance the methods take turns, one pass each, ``repeats`` rounds (after one untimed
-    # pass each): the floors a ratio divides are timed side by side, so a machine that slows down for
-    # a while slows them alike, and the best pass of each comes from its fastest stretch
+    # at each tolerance the methods take turns, one pass each, ``repeats`` rounds after one untimed pass
+    # each (the methods of ``least_repeats`` take their extra rounds last): the floors a ratio divides are
+    # timed side by side, so a machine that slows down for a while slows them alike, and the best pass
+    # of each comes from its fastest stretch
     for rtol in sorted({r["rtol"] for r in points}, reverse=True):
         at = [{"scene": name, "method": r["method"], "rtol": rtol, "error": r["error"]} for r in points if r["rtol"] == rtol]
         paths = {}

@@ -400,3 +400,26 @@ def test_floor_methods_take_turns_at_each_tolerance(monkeypatch):
     assert passes == [(m, r) for r in (1e-4, 1e-6) for m in turn * 3]       # an untimed pass each, then two rounds
     assert [(row["method"], row["rtol"]) for row in low["rows"]] == [(m, r) for m in floor.METHODS for r in (1e-4, 1e-6)]
     assert all(row["time_s"] == 2e-3 for row in low["rows"])               # the best of the timed passes (3, 2 ms)
+
+
+def test_floor_methods_with_more_repeats_take_the_extra_rounds_after_the_others(monkeypatch):
+    """``least_repeats``: IDAS's short floor passes timed more often than its peers', the peers in the
+    first rounds."""
+    passes = []
+
+    def floor_pass(model, parts, method, rtol, path):
+        passes.append(method)
+        return 1e-3 * (10 - passes.count(method)), 1e-9
+
+    class Reference:
+        model = type("Model", (), {"scene": type("Scene", (), {"name": "s"})()})()
+
+    monkeypatch.setattr(floor, "pieces", lambda reference: [])
+    monkeypatch.setattr(floor, "floor_path", lambda model, method, rtol, native=False: None)
+    monkeypatch.setattr(floor, "floor_pass", floor_pass)
+    sweep_rows = [{"method": m, "rtol": 1e-5, "status": "ok", "error": 1e-5} for m in floor.METHODS]
+    low = floor.integrator_floor(Reference(), sweep_rows, repeats=2, least_repeats={"idas": 4})
+    turn = ["idas", "Radau", "LSODA"]
+    assert passes == turn * 3 + ["idas", "idas"]               # an untimed pass each, two rounds, two more for IDAS
+    best = {row["method"]: row["time_s"] for row in low["rows"]}
+    assert best == pytest.approx({"idas": 5e-3, "Radau": 7e-3, "LSODA": 7e-3})   # the last (fastest) pass of each

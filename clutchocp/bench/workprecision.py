@@ -40,6 +40,7 @@ from ..errors import ClutchocpError, ModelError
 from ..output import new_figure, save_figure, write_csv
 from .event_work import event_work_time
 from .summary_work import summary_time
+from .turns import best_of_turns
 
 METHODS = ("idas", "idas-native", "cvodes", "Radau", "BDF", "LSODA")
 SCIPY = ("Radau", "BDF", "LSODA")
@@ -222,18 +223,23 @@ def _points(scene, model, reference, methods, rtol, repeats, least_repeats, prog
     until each has had its :func:`timed_runs` (the best wall time, and its run, counts; the best CPU
     time apart), then each row gets its errors against ``reference``."""
     counts = {method: timed_runs(method, repeats, least_repeats) for method in methods}
-    best = dict.fromkeys(methods, (math.inf, math.inf, None))
-    failed = {}
-    for attempt in range(max(counts.values(), default=0)):
-        for method in (m for m in methods if attempt < counts[m] and m not in failed):
+    failed, best_cpu = {}, dict.fromkeys(methods, math.inf)
+
+    def task(method):
+        def timed():
+            if method in failed:                 # out of the remaining rounds
+                return math.inf, None
             start = time.perf_counter()
             try:
                 wall, cpu, run = timed_run(scene, model, method, rtol)
-            except ClutchocpError as exc:   # e.g. scipy BDF's step size collapsing at the impact
+            except ClutchocpError as exc:       # e.g. scipy BDF's step size collapsing at the impact
                 failed[method] = (exc, time.perf_counter() - start)
-                continue
-            best_wall, best_cpu, best_run = best[method]
-            best[method] = (wall, min(cpu, best_cpu), run) if wall < best_wall else (best_wall, min(cpu, best_cpu), best_run)
+                return math.inf, None
+            best_cpu[method] = min(best_cpu[method], cpu)
+            return wall, run
+        return timed
+
+    best = best_of_turns({method: task(method) for method in methods}, counts, warm_up=False)
     rows = []
     for method in methods:
         row = {"scene": scene.name, "method": method, "rtol": rtol, "atol": rtol * ATOL_RATIO}
@@ -244,7 +250,7 @@ def _points(scene, model, reference, methods, rtol, repeats, least_repeats, prog
                 progress.step(f"{scene.name} {method:11s} rtol {rtol:.0e}: FAILED ({str(exc)[:70]}...)")
             rows.append(row)
             continue
-        wall, cpu, run = best[method]
+        (wall, run), cpu = best[method], best_cpu[method]
         stats = run.summary["solver"]["statistics"]
         if method == "idas":        # before the errors read more outputs
             row["summary_work_s"] = summary_time(run, counts[method])[0]

@@ -15,7 +15,7 @@ from clutchocp.bench import workprecision as wp
 from clutchocp.bench.progress import Progress
 from clutchocp.engagement.model import EngagementModel
 from clutchocp.engagement.run import simulate_engagement
-from clutchocp.errors import ModelError, SolverError
+from clutchocp.errors import ClutchocpError, ModelError, SolverError
 from clutchocp.scene.loader import load_scene
 
 
@@ -423,3 +423,25 @@ def test_floor_methods_with_more_repeats_take_the_extra_rounds_after_the_others(
     assert passes == turn * 3 + ["idas", "idas"]               # an untimed pass each, two rounds, two more for IDAS
     best = {row["method"]: row["time_s"] for row in low["rows"]}
     assert best == pytest.approx({"idas": 5e-3, "Radau": 7e-3, "LSODA": 7e-3})   # the last (fastest) pass of each
+
+
+def test_a_method_failing_in_a_round_is_reported_and_not_timed_again(monkeypatch):
+    timed = []
+
+    class Run:
+        summary = {"solver": {"statistics": {"integration_time_s": 1e-3, "n_steps": 10}}, "engagement_time_s": 0.1}
+
+    def timed_run(scene, model, method, rtol, repeats=1, **options):
+        timed.append(method)
+        if method == "idas" and timed.count("idas") == 2:
+            raise ClutchocpError("IDAS failed at t = 0.1 s")
+        return 2e-3, 4e-3, Run()
+
+    monkeypatch.setattr(wp, "timed_run", timed_run)
+    monkeypatch.setattr(wp, "trajectory_errors", lambda run, reference: dict.fromkeys(("max", *wp.ERROR_PARTS), 1e-6))
+    scene = type("Scene", (), {"name": "s"})()
+    rows = wp._points(scene, None, None, ("idas", "Radau"), 1e-6, 1, {"Radau": 3}, None)
+    assert timed == ["idas", "Radau", "idas", "Radau", "Radau"]     # no idas run after its failure
+    idas, radau = rows
+    assert idas["status"].startswith("failed: IDAS failed") and radau["status"] == "ok"
+    assert radau["wall_time_s"] == 2e-3 and radau["cpu_time_s"] == 4e-3

@@ -916,8 +916,8 @@ def r_first_call_stop(n):
                    "ended call saves", "whole / floor factor"), rows)
             + f"\n(rtol {', '.join(f'{r:g}' for r in rtols)}; the first integrator call of the slipping piece; the "
               "three calls and a whole run take turns, one timed call each per round, best of 15 each, so a run "
-              "is timed after the CasADi call and reads slower than one of a series of runs; samples changed: the largest change of the scaled states before the event against the "
-              "call to the piece end; whole / floor factor: 1 / (1 - saving), the most an ended first call would "
+              "is timed after the CasADi call and reads slower than one of a series of runs; samples changed: the "
+              "largest change of the scaled states before the event against the call to the piece end; whole / floor factor: 1 / (1 - saving), the most an ended first call would "
               f"raise whole / floor by with every other time unchanged; `{d['command']}`; "
               f"{measured(n, 'first_call_stop')}.)\n")
 

@@ -21,11 +21,15 @@ time (wall clock) is split with timers around:
 * ``grid_evaluations``: functions evaluated on two or more samples (outputs and event functions on
   the output grid, ``ColumnFunction``), in the hybrid loop and in the summary;
 * ``summary``: :func:`clutchocp.engagement.measures.summarize` without its evaluations;
-* ``loop``: the rest (call planning, event scan and location logic, resets, one-sample evaluations,
-  result assembly).
+* ``hybrid_loop``: the rest of the hybrid loop (``_Run.loop``: call planning, event scan and location
+  logic, mode switches and resets, one-sample evaluations);
+* ``setup_and_assembly``: the rest of the run, outside the loop and the summary (the engagement
+  wrapper, the model's inputs and first state, the result built from the samples).
 
-``whole_over_floor_without_loop`` is the ratio a run would reach if its loop cost nothing: its
-integrator calls as they are (results unchanged), its grid evaluations and summary.
+``whole_over_floor_without_loop`` is the ratio a run would reach if its loop, setup and assembly cost
+nothing: its integrator calls as they are (results unchanged), its grid evaluations and summary.
+``whole_over_floor_without_hybrid_loop`` is the ratio a run would reach if the hybrid loop alone cost
+nothing (compiled, say) and everything else stayed as it is: the most a faster hybrid loop gives.
 
 ``summary_work_ms`` is the work every whole run does after its integration, IDAS's and Radau's alike:
 the outputs the summary reads, evaluated afresh on the run's samples, and the summary itself
@@ -82,13 +86,15 @@ class PartTimers:
     def __init__(self):
         import clutchocp.engagement.run as run
         import clutchocp.simulation.compiled as compiled
+        import clutchocp.simulation.driver as driver
         import clutchocp.simulation.idas_path as idas_path
 
-        self.parts, self._depth, self._in_summary, self._undo = {}, 0, False, []
+        self.parts, self._depth, self._in_summary, self._in_loop, self._undo = {}, 0, False, False, []
         self._wrap(idas_path.IdasPath, "_run", self._timed("integrator_calls"))
         for name in ("__call__", "on_numpy"):
             self._wrap(compiled.ColumnFunction, name, self._evaluation)
-        self._wrap(run, "summarize", self._summary)
+        self._wrap(run, "summarize", self._within("_in_summary", "summary_total"))
+        self._wrap(driver._Run, "loop", self._within("_in_loop", "loop_total"))
 
     def _wrap(self, owner, name, make):
         inner = getattr(owner, name)
@@ -109,7 +115,10 @@ class PartTimers:
                 try:
                     return inner(*args, **kwargs)
                 finally:
-                    self._add(label, time.perf_counter() - start)
+                    seconds = time.perf_counter() - start
+                    self._add(label, seconds)
+                    if self._in_loop:
+                        self._add(f"loop_{label}", seconds)
             return timed
         return make
 
@@ -127,18 +136,24 @@ class PartTimers:
                     self._add("grid_evaluations", seconds)
                     if self._in_summary:
                         self._add("summary_evaluations", seconds)
+                    if self._in_loop:
+                        self._add("loop_grid_evaluations", seconds)
         return timed
 
-    def _summary(self, inner):
-        def timed(*args, **kwargs):
-            self._in_summary = True
-            start = time.perf_counter()
-            try:
-                return inner(*args, **kwargs)
-            finally:
-                self._in_summary = False
-                self._add("summary_total", time.perf_counter() - start)
-        return timed
+    def _within(self, flag, label):
+        """A wrapper that times its calls as ``label`` with the attribute ``flag`` true while they run
+        (the calls and evaluations made inside are then also counted as inside)."""
+        def make(inner):
+            def timed(*args, **kwargs):
+                setattr(self, flag, True)
+                start = time.perf_counter()
+                try:
+                    return inner(*args, **kwargs)
+                finally:
+                    setattr(self, flag, False)
+                    self._add(label, time.perf_counter() - start)
+            return timed
+        return make
 
 
 def summary_and_event_work(scene, model, method, rtol, repeats):
@@ -167,7 +182,7 @@ def summary_and_event_work(scene, model, method, rtol, repeats):
 def parts_task(scene, model, method, rtol):
     """A task (:func:`clutchocp.bench.turns.best_of_turns`) of one run with :class:`PartTimers` installed
     around it alone: its wall time [s] and its parts [s] (``integrator_calls``, ``grid_evaluations``,
-    ``summary``, ``loop``)."""
+    ``summary``, ``hybrid_loop``, ``setup_and_assembly``)."""
     from clutchocp.bench.workprecision import run_method
 
     def task():
@@ -181,8 +196,10 @@ def parts_task(scene, model, method, rtol):
         parts = timers.parts
         summary = parts.get("summary_total", 0.0) - parts.get("summary_evaluations", 0.0)
         named = {"integrator_calls": parts.get("integrator_calls", 0.0),
-                 "grid_evaluations": parts.get("grid_evaluations", 0.0), "summary": summary}
-        named["loop"] = whole - sum(named.values())
+                 "grid_evaluations": parts.get("grid_evaluations", 0.0), "summary": summary,
+                 "hybrid_loop": parts.get("loop_total", 0.0) - parts.get("loop_integrator_calls", 0.0)
+                 - parts.get("loop_grid_evaluations", 0.0)}
+        named["setup_and_assembly"] = whole - sum(named.values())
         return whole, named
 
     return task
@@ -230,6 +247,8 @@ def measure(name, rtols, repeats, engines):
                 "whole_over_floor": whole_over_floor(t_whole, t_floor, r_whole, r_floor),
                 "whole_over_floor_without_loop": whole_over_floor(
                     split["integrator_calls"] + split["grid_evaluations"] + split["summary"], t_floor, r_whole, r_floor),
+                "whole_over_floor_without_hybrid_loop": whole_over_floor(
+                    timed_whole - split["hybrid_loop"], t_floor, r_whole, r_floor),
                 "idas_whole_ms": 1e3 * t_whole, "idas_floor_ms": 1e3 * t_floor,
                 "radau_whole_ms": 1e3 * r_whole, "radau_floor_ms": 1e3 * r_floor,
                 "budget_ms": 1e3 * allowed, "budget_beyond_floor_ms": 1e3 * (allowed - t_floor),
@@ -255,11 +274,13 @@ def measure(name, rtols, repeats, engines):
 def _line(row):
     p = row["parts_ms"]
     return (f"{row['scene']:<26} {row['engine']:<6} rtol {row['rtol']:.0e}: whole/floor {row['whole_over_floor']:.2f} "
-            f"(without the loop {row['whole_over_floor_without_loop']:.2f}); "
+            f"(without the hybrid loop {row['whole_over_floor_without_hybrid_loop']:.2f}, without it, setup and "
+            f"assembly {row['whole_over_floor_without_loop']:.2f}); "
             f"IDAS whole {row['idas_whole_ms']:.2f} ms, budget {row['budget_ms']:.2f} ms (floor {row['idas_floor_ms']:.2f} "
             f"+ {row['budget_beyond_floor_ms']:.2f}); timed run {row['timed_whole_ms']:.2f} ms = integrator calls "
             f"{p['integrator_calls']:.2f} (floor + {row['integrator_excess_ms']:.2f}) + grid evaluations "
-            f"{p['grid_evaluations']:.2f} + summary {p['summary']:.2f} + loop {p['loop']:.2f}; "
+            f"{p['grid_evaluations']:.2f} + summary {p['summary']:.2f} + hybrid loop {p['hybrid_loop']:.2f} + setup and "
+            f"assembly {p['setup_and_assembly']:.2f}; "
             f"Radau beyond its floor {row['radau_beyond_floor_ms']:.2f} ms; summary work {row['summary_work_ms']:.2f} ms: "
             f"ideal whole/floor {row['whole_over_floor_ideal']:.2f}, with the calls as they are "
             f"{row['whole_over_floor_calls_and_summary']:.2f}, with the event functions on the samples too "

@@ -4,6 +4,7 @@ at which that ratio meets the target, and its timers split a run without countin
 import pytest
 
 from clutchocp.simulation.compiled import ColumnFunction
+from clutchocp.simulation.driver import _Run
 from clutchocp.simulation.idas_path import IdasPath
 from repo_scripts import load_script
 
@@ -24,16 +25,46 @@ def test_budget_is_the_run_time_at_which_the_bench_ratio_meets_the_target():
 
 
 def test_parts_of_a_run_add_up_and_the_timers_are_removed():
-    inner = (ColumnFunction.__call__, ColumnFunction.on_numpy, IdasPath._run)
+    inner = (ColumnFunction.__call__, ColumnFunction.on_numpy, IdasPath._run, _Run.loop)
     rows = _bench().measure("zhang2021", [1e-5], repeats=1, engines=["vm"])
-    assert (ColumnFunction.__call__, ColumnFunction.on_numpy, IdasPath._run) == inner
+    assert (ColumnFunction.__call__, ColumnFunction.on_numpy, IdasPath._run, _Run.loop) == inner
     (row,) = rows
     parts = row["parts_ms"]
-    assert set(parts) == {"integrator_calls", "grid_evaluations", "summary", "loop"}
-    assert all(value > 0 for value in parts.values()), parts          # a part counted twice drives the loop below 0
+    assert set(parts) == {"integrator_calls", "grid_evaluations", "summary", "hybrid_loop", "setup_and_assembly"}
+    # a part counted twice drives the hybrid loop or the setup and assembly below 0
+    assert all(value > 0 for value in parts.values()), parts
     assert sum(parts.values()) == pytest.approx(row["timed_whole_ms"], rel=1e-12)
     assert row["whole_over_floor"] < row["whole_over_floor_without_loop"]
     assert row["budget_ms"] > row["idas_floor_ms"] > 0
+
+
+def test_hybrid_loop_is_the_loop_without_the_calls_and_evaluations_made_inside_it():
+    import clutchocp.simulation.driver as driver
+    from clutchocp.bench.workprecision import run_method
+    from clutchocp.engagement.model import EngagementModel
+    from clutchocp.scene import load_scene
+
+    scene = load_scene("zhang2021")
+    model = EngagementModel(scene)
+    run_method(scene, model, "idas", 1e-5)                       # builds and caches the integrators
+    timers = _bench().PartTimers()
+    try:
+        run_method(scene, model, "idas", 1e-5)
+        parts = dict(timers.parts)
+    finally:
+        timers.remove()
+    assert driver._Run.loop is _Run.loop
+    # every integrator call is made inside the loop; of the grid evaluations, those of the summary are not
+    assert parts["loop_integrator_calls"] == parts["integrator_calls"]
+    assert parts["loop_grid_evaluations"] == pytest.approx(
+        parts["grid_evaluations"] - parts.get("summary_evaluations", 0.0), rel=1e-12)
+    assert parts["loop_total"] > parts["loop_integrator_calls"] + parts["loop_grid_evaluations"]
+    (row,) = _bench().measure("zhang2021", [1e-5], repeats=1, engines=["vm"])
+    hybrid = row["parts_ms"]["hybrid_loop"]
+    assert row["whole_over_floor_without_hybrid_loop"] == pytest.approx(
+        (row["idas_floor_ms"] / (row["timed_whole_ms"] - hybrid)) * (row["radau_whole_ms"] / row["radau_floor_ms"]),
+        rel=1e-12)
+    assert row["whole_over_floor"] < row["whole_over_floor_without_hybrid_loop"] < row["whole_over_floor_without_loop"]
 
 
 def test_ideal_ratio_is_that_of_a_run_costing_its_floor_plus_the_summary_work():

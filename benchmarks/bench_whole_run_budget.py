@@ -45,6 +45,13 @@ loop can skip while the grid detects the events: the event functions on every sa
 (:mod:`clutchocp.bench.event_work`, the bench's ``event_work_s``); ``whole_over_floor_calls_summary_events``
 the ratio of a run made of its calls, the summary work and that event work.
 
+``whole_over_floor_calls_replayed`` is the ratio of a run made of its own calls into compiled code,
+recorded on one run (:class:`clutchocp.bench.call_replay.CallRecorder`: the integrator calls and their statistics, the column
+functions on the grid or at one sample, other CasADi functions such as the consistent-initialisation
+Newton solve) and issued back to back from Python with nothing between them (``replayed_calls_ms``),
+plus the summary's own arithmetic (``parts_ms["summary"]``): what a Python engine that makes the same
+calls, so gives the same results, reaches with its hybrid loop, setup and assembly costing nothing.
+
 The Radau run pays the same grid evaluations and summary after its integration. ``engine``: ``vm``
 (CasADi's virtual machine and numpy, the default) and ``native`` (the equations, outputs and event
 functions compiled to C, ``simulate_engagement(native=True)``; its floor integrates the compiled
@@ -59,6 +66,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from clutchocp.bench.call_replay import Patches, recorded_calls
 
 SCENES = ("zhang2021", "default_driveline", "default_driveline_thermal")
 TARGET = 0.6
@@ -79,7 +88,7 @@ def whole_over_floor(t_whole, t_floor, r_whole, r_floor):
     return ratio(entry, peers=("Radau",))["whole_over_floor_vs_radau"]
 
 
-class PartTimers:
+class PartTimers(Patches):
     """Wall-clock timers around the parts of an engagement run (see the module docstring), installed
     on the classes until :meth:`remove`; only the outermost of nested grid evaluations counts."""
 
@@ -89,21 +98,13 @@ class PartTimers:
         import clutchocp.simulation.driver as driver
         import clutchocp.simulation.idas_path as idas_path
 
-        self.parts, self._depth, self._in_summary, self._in_loop, self._undo = {}, 0, False, False, []
+        super().__init__()
+        self.parts, self._depth, self._in_summary, self._in_loop = {}, 0, False, False
         self._wrap(idas_path.IdasPath, "_run", self._timed("integrator_calls"))
         for name in ("__call__", "on_numpy"):
             self._wrap(compiled.ColumnFunction, name, self._evaluation)
         self._wrap(run, "summarize", self._within("_in_summary", "summary_total"))
         self._wrap(driver._Run, "loop", self._within("_in_loop", "loop_total"))
-
-    def _wrap(self, owner, name, make):
-        inner = getattr(owner, name)
-        setattr(owner, name, functools.wraps(inner)(make(inner)))
-        self._undo.append((owner, name, inner))
-
-    def remove(self):
-        for owner, name, inner in reversed(self._undo):
-            setattr(owner, name, inner)
 
     def _add(self, label, seconds):
         self.parts[label] = self.parts.get(label, 0.0) + seconds
@@ -227,19 +228,25 @@ def measure(name, rtols, repeats, engines):
         tasks = {"radau_whole": wall(functools.partial(run_method, scene, model, "Radau", rtol)),
                  "radau_floor": functools.partial(floor.floor_pass, model, parts, "Radau", rtol, radau_path)}
         counts = {"radau_whole": max(3, repeats // 3), "radau_floor": max(3, repeats // 3)}
+        recorders = {}
         for engine in engines:
             method = "idas-native" if engine == "native" else "idas"
             path = floor.floor_path(model, "idas", rtol, native=engine == "native")
+            run_method(scene, model, method, rtol)                # builds what a run builds before its calls are recorded
+            recorders[engine] = recorded_calls(scene, model, method, rtol)
             tasks.update({f"{engine}_whole": wall(functools.partial(run_method, scene, model, method, rtol)),
                           f"{engine}_floor": functools.partial(floor.floor_pass, model, parts, "idas", rtol, path),
-                          f"{engine}_parts": parts_task(scene, model, method, rtol)})
-            counts.update(dict.fromkeys((f"{engine}_whole", f"{engine}_floor", f"{engine}_parts"), repeats))
+                          f"{engine}_parts": parts_task(scene, model, method, rtol),
+                          f"{engine}_replay": wall(recorders[engine].replay)})
+            counts.update(dict.fromkeys((f"{engine}_whole", f"{engine}_floor", f"{engine}_parts", f"{engine}_replay"),
+                                        repeats))
         best = best_of_turns(tasks, counts)
         r_whole, r_floor = best["radau_whole"][0], best["radau_floor"][0]
         for engine in engines:
             method = "idas-native" if engine == "native" else "idas"
             t_whole, t_floor = best[f"{engine}_whole"][0], best[f"{engine}_floor"][0]
             timed_whole, split = best[f"{engine}_parts"]
+            replayed = best[f"{engine}_replay"][0]
             allowed = budget(t_floor, r_whole, r_floor)
             work, events = summary_and_event_work(scene, model, method, rtol, repeats)
             rows.append({
@@ -266,6 +273,8 @@ def measure(name, rtols, repeats, engines):
                 "path_overhead_ms": 1e3 * (t_whole - t_floor - work),
                 "path_allowance_ms": 1e3 * (allowed - t_floor - work),
                 "after_integration_ms": 1e3 * (split["grid_evaluations"] + split["summary"]),
+                "replayed_calls_ms": 1e3 * replayed, "replayed_calls": recorders[engine].counts(),
+                "whole_over_floor_calls_replayed": whole_over_floor(replayed + split["summary"], t_floor, r_whole, r_floor),
             })
             print(_line(rows[-1]), file=sys.stderr, flush=True)
     return rows
@@ -284,7 +293,9 @@ def _line(row):
             f"Radau beyond its floor {row['radau_beyond_floor_ms']:.2f} ms; summary work {row['summary_work_ms']:.2f} ms: "
             f"ideal whole/floor {row['whole_over_floor_ideal']:.2f}, with the calls as they are "
             f"{row['whole_over_floor_calls_and_summary']:.2f}, with the event functions on the samples too "
-            f"({row['event_work_ms']:.2f} ms) {row['whole_over_floor_calls_summary_events']:.2f}, IDAS path "
+            f"({row['event_work_ms']:.2f} ms) {row['whole_over_floor_calls_summary_events']:.2f}, with the run's own "
+            f"calls replayed back to back ({row['replayed_calls_ms']:.2f} ms) and the summary's arithmetic "
+            f"{row['whole_over_floor_calls_replayed']:.2f}; IDAS path "
             f"{row['path_overhead_ms']:.2f} ms "
             f"against an allowance of {row['path_allowance_ms']:.2f} ms")
 

@@ -884,11 +884,13 @@ def r_bench(n):
              fmt(v.get("speedup_vs_lsoda"), 3), fmt(v.get("floor_speedup_vs_radau"), 3),
              fmt(v.get("whole_over_floor_vs_radau"), 2), fmt(v.get("whole_over_floor_bound_vs_radau"), 2),
              fmt(v.get("whole_over_floor_summary_bound_vs_radau"), 2),
-             fmt(v.get("whole_over_floor_events_bound_vs_radau"), 2), fmt(v.get("scaling_exponent_pairs"), 3))
+             fmt(v.get("whole_over_floor_events_bound_vs_radau"), 2), fmt(v.get("whole_over_floor_replay_bound_vs_radau"), 2),
+             fmt(v.get("scaling_exponent_pairs"), 3))
             for name, v in scenes.items()]
     return (table(("scene", "IDAS speed-up vs Radau", "vs BDF", "vs LSODA", "integrator floor vs Radau",
                    "whole / floor", "bound (no time outside the integrator)", "bound (no time outside the integrator "
-                   "and the summary work)", "bound (... and the event checks)", "run time ~ pairs^k: k"), rows)
+                   "and the summary work)", "bound (... and the event checks)", "bound (the run's own calls replayed, and the "
+                   "summary's arithmetic)", "run time ~ pairs^k: k"), rows)
             + "\n(speed-ups at matched error, the geometric mean over the error levels both reach; whole / floor: the "
               "whole run's speed-up over Radau divided by the floor's, below 1 where the run spends time outside "
               "the integrator: output grid, event location, summary; bound: the whole / floor a run would reach "
@@ -897,7 +899,11 @@ def r_bench(n):
               "the work every whole run does after its integration, Radau's too (the outputs its summary reads and "
               "the summary), added to IDAS's calls; bound with the event checks: the same with the event functions "
               "on the samples the run keeps added too, the detection a run that finds its events on its output "
-              "grid cannot skip: what a hybrid loop costing nothing else would reach; "
+              "grid cannot skip: what a hybrid loop costing nothing else would reach; bound with the calls replayed: "
+              "every call the run makes into compiled code (integrators, outputs and event functions on the grid or "
+              "at one sample) made again back to back from Python, plus the summary's own arithmetic: what an "
+              "engine in Python making the same calls, so giving the same results, reaches when the Python around "
+              "them costs nothing; "
               f"`{n['bench']['command']}`; {measured(n, 'bench')}.)\n")
 
 

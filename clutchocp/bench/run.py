@@ -22,7 +22,10 @@
   :func:`whole_over_floor_bound`), spending no time outside them and the summary work every
   whole run does (``whole_over_floor_summary_bound_vs_radau``, ``..._vs_lsoda``), and outside them,
   the summary work and the event checks on the samples the run keeps
-  (``whole_over_floor_events_bound_vs_radau``, ``..._vs_lsoda``);
+  (``whole_over_floor_events_bound_vs_radau``, ``..._vs_lsoda``), and made of the run's own calls
+  into compiled code replayed back to back and the summary's arithmetic
+  (``whole_over_floor_replay_bound_vs_radau``, ``..._vs_lsoda``: an engine in Python making the same
+  calls, with nothing around them);
   ``idas_slower``: every scene, peer and matched error level at which a peer was faster than IDAS
   (a measured fact, not a target); ``single_run_s``: one warm bao2020 engagement at its settings;
 * ``engagement_integrator_floor.csv`` -- the floor of every method and tolerance (also drawn,
@@ -120,8 +123,8 @@ def run_bench(out_dir, quick=False, progress=True, scenes=None):
                                                                  repeats=settings["scaling_repeats"], progress=bar)
         per_scene[scene.name] = {**_scene_summary(res, profile, scaling_results[scene.name], speed_rows), **low}
         per_scene[scene.name].update(whole_over_floor(per_scene[scene.name]))
-        for work in BOUND_WORK:
-            per_scene[scene.name].update(whole_over_floor_bound(res["rows"], per_scene[scene.name], work=work))
+        for bound in BOUNDS:
+            per_scene[scene.name].update(whole_over_floor_bound(res["rows"], per_scene[scene.name], bound=bound))
 
     files.append(workprecision.write_rows(out / "engagement_work_precision.csv", [r for res in results for r in res["rows"]]))
     files.append(workprecision.write_rows(out / "engagement_integrator_floor.csv", [r for rows in floors.values() for r in rows],
@@ -196,27 +199,38 @@ def whole_over_floor(entry, peers=floor.PEERS):
     return out
 
 
-BOUND_WORK = {(): "whole_over_floor_bound", ("summary_work_s",): "whole_over_floor_summary_bound",
-              ("summary_work_s", "event_work_s"): "whole_over_floor_events_bound"}
+BOUNDS = {"whole_over_floor_bound": ("integration_time_s",),
+          "whole_over_floor_summary_bound": ("integration_time_s", "summary_work_s"),
+          "whole_over_floor_events_bound": ("integration_time_s", "summary_work_s", "event_work_s"),
+          "whole_over_floor_replay_bound": ("replayed_calls_s", "summary_arithmetic_s")}
 
 
-def whole_over_floor_bound(rows, entry, peers=floor.PEERS, levels=workprecision.ERROR_LEVELS, work=()):
-    """The whole / floor a run would reach if it spent no time outside its integrator calls and the
-    ``work`` named.
+def whole_over_floor_bound(rows, entry, peers=floor.PEERS, levels=workprecision.ERROR_LEVELS,
+                           bound="whole_over_floor_bound"):
+    """The whole / floor a run would reach if it spent no time outside the parts :data:`BOUNDS` names
+    for ``bound``.
 
-    Per peer: the peer's whole-run time over IDAS's time inside its integrator calls
-    (``integration_time_s``) plus the ``work`` (row keys [s]) at matched error, averaged over the
-    error levels as ``speedup_vs_<peer>`` is (:func:`~clutchocp.bench.workprecision.headline`),
-    divided by ``floor_speedup_vs_<peer>``. The calls of a whole run start and stop where its events
-    are found (it cannot know an event before integrating past it), so they cost more than the floor's
-    one call per mode piece, and moving where they start and stop moves IDAS's steps, so its results.
-    With ``work=()`` the bound is what whole / floor could reach by cutting everything between the
-    calls. The summary work (``summary_work_s``: the outputs the summary reads and the summary,
-    :mod:`~clutchocp.bench.summary_work`) is paid by the peers' whole runs as well, and the event work
-    (``event_work_s``: the event functions on the samples the run keeps,
-    :mod:`~clutchocp.bench.event_work`) by any run that finds its events on its output grid; with
-    both, the bound is what a hybrid loop that cost nothing else (event location, restarts and
-    bookkeeping) would reach with the calls as they are.
+    Per peer: the peer's whole-run time over the sum of IDAS's parts (row keys [s]) at matched error,
+    averaged over the error levels as ``speedup_vs_<peer>`` is
+    (:func:`~clutchocp.bench.workprecision.headline`), divided by ``floor_speedup_vs_<peer>``.
+
+    * ``whole_over_floor_bound``: the integrator calls alone (``integration_time_s``), what whole /
+      floor could reach by cutting everything between them. The calls of a whole run start and stop
+      where its events are found (it cannot know an event before integrating past it), so they cost
+      more than the floor's one call per mode piece, and moving where they start and stop moves
+      IDAS's steps, so its results.
+    * ``whole_over_floor_summary_bound``: and the summary work (``summary_work_s``: the outputs the
+      summary reads and the summary, :mod:`~clutchocp.bench.summary_work`), which the peers' whole
+      runs pay as well.
+    * ``whole_over_floor_events_bound``: and the event work (``event_work_s``: the event functions
+      on the samples the run keeps, :mod:`~clutchocp.bench.event_work`), which any run that finds
+      its events on its output grid pays: what a hybrid loop that cost nothing else (event location,
+      restarts and bookkeeping) would reach with the calls as they are.
+    * ``whole_over_floor_replay_bound``: every call the run makes into compiled code, integrators
+      and evaluations alike, replayed back to back (``replayed_calls_s``,
+      :mod:`~clutchocp.bench.call_replay`), and the summary's own arithmetic
+      (``summary_arithmetic_s``): what an engine in Python that makes the same calls, so gives the
+      same results, reaches when the Python around them (loop, setup, result assembly) costs nothing.
 
     Parameters
     ----------
@@ -229,22 +243,22 @@ def whole_over_floor_bound(rows, entry, peers=floor.PEERS, levels=workprecision.
         The floor's peers.
     levels : sequence of float
         The matched error levels (those of ``speedup_vs_<peer>``).
-    work : tuple of str
-        A key of :data:`BOUND_WORK`: the work counted with IDAS's integrator calls.
+    bound : str
+        A key of :data:`BOUNDS`.
 
     Returns
     -------
     dict
-        ``{<BOUND_WORK[work]>_vs_<peer>: float or None}`` (None where a ratio is missing).
+        ``{<bound>_vs_<peer>: float or None}`` (None where a ratio is missing).
     """
-    name, idas_key = BOUND_WORK[tuple(work)], "calls_and_work_s"
-    rows = [{**r, idas_key: r["integration_time_s"] + sum(r[k] for k in work)}
+    parts, idas_key = BOUNDS[bound], "calls_and_work_s"
+    rows = [{**r, idas_key: sum(r[k] for k in parts)}
             if r["method"] == "idas" and r.get("status") == "ok" else r for r in rows]
     ratios = workprecision.speedups(rows, peers=peers, levels=levels, key="wall_time_s", idas_key=idas_key)
     out = {}
     for peer, by_level in ratios.items():
-        bound, low = workprecision.headline(by_level)[0], entry.get(f"floor_speedup_vs_{peer.lower()}")
-        out[f"{name}_vs_{peer.lower()}"] = bound / low if bound is not None and low else None
+        ratio, low = workprecision.headline(by_level)[0], entry.get(f"floor_speedup_vs_{peer.lower()}")
+        out[f"{bound}_vs_{peer.lower()}"] = ratio / low if ratio is not None and low else None
     return out
 
 
@@ -314,7 +328,10 @@ def format_summary(summary):
                      f"Radau {num(e.get('whole_over_floor_summary_bound_vs_radau'))}, "
                      f"LSODA {num(e.get('whole_over_floor_summary_bound_vs_lsoda'))}; and the event checks: "
                      f"Radau {num(e.get('whole_over_floor_events_bound_vs_radau'))}, "
-                     f"LSODA {num(e.get('whole_over_floor_events_bound_vs_lsoda'))})")
+                     f"LSODA {num(e.get('whole_over_floor_events_bound_vs_lsoda'))}; the run's own calls "
+                     f"replayed back to back and the summary's arithmetic: "
+                     f"Radau {num(e.get('whole_over_floor_replay_bound_vs_radau'))}, "
+                     f"LSODA {num(e.get('whole_over_floor_replay_bound_vs_lsoda'))})")
         lines.append(f"    run time ~ pairs^{e['scaling_exponent_pairs']:.2f}; stiffness ratio up to "
                      f"{num(stiff['max_stiffness_ratio'], '{:.3g}')}, fastest time constant "
                      f"{num(stiff['min_time_constant_s'], '{:.3g}')} s")

@@ -24,7 +24,9 @@ summary) with the model built and its integrators cached by an untimed warm-up r
 summary reads, evaluated afresh, and the summary: :mod:`clutchocp.bench.summary_work`), which
 every whole run pays whatever integrates it, and of its event work (its modes' event functions on
 the samples it keeps: :mod:`clutchocp.bench.event_work`), which the floor, knowing its events,
-skips. Times at matched error come from the Pareto front of each method's (error, time) points,
+skips, of its summary's arithmetic alone (its outputs evaluated beforehand), and of the calls its run
+makes into compiled code replayed back to back (:mod:`clutchocp.bench.call_replay`): the least an
+engine in Python making the same calls costs. Times at matched error come from the Pareto front of each method's (error, time) points,
 interpolated in log-log (:func:`time_at_error`).
 """
 
@@ -38,8 +40,9 @@ from ..engagement.model import EngagementModel
 from ..engagement.run import simulate_engagement
 from ..errors import ClutchocpError, ModelError
 from ..output import new_figure, save_figure, write_csv
+from .call_replay import run_replay_time
 from .event_work import event_work_time
-from .summary_work import summary_time
+from .summary_work import summary_arithmetic_time, summary_time
 from .turns import best_of_turns
 
 METHODS = ("idas", "idas-native", "cvodes", "Radau", "BDF", "LSODA")
@@ -255,6 +258,8 @@ def _points(scene, model, reference, methods, rtol, repeats, least_repeats, prog
         if method == "idas":        # before the errors read more outputs
             row["summary_work_s"] = summary_time(run, counts[method])[0]
             row["event_work_s"] = event_work_time(run, counts[method])
+            row["summary_arithmetic_s"] = summary_arithmetic_time(run, counts[method])
+            row["replayed_calls_s"] = run_replay_time(scene, model, method, rtol, counts[method])
         errors = trajectory_errors(run, reference)
         row.update(status="ok", wall_time_s=wall, cpu_time_s=cpu, error=errors["max"],
                    integration_time_s=stats.get("integration_time_s"),
@@ -337,8 +342,8 @@ def headline(ratios):
 
 
 SWEEP_COLUMNS = ("scene", "method", "rtol", "atol", "status", "wall_time_s", "cpu_time_s", "integration_time_s",
-                 "summary_work_s", "event_work_s", "error", *(f"error_{k}" for k in ERROR_PARTS), "engagement_time_s", "n_steps", "n_rhs_evals",
-                 "n_jacobian_evals")
+                 "summary_work_s", "event_work_s", "summary_arithmetic_s", "replayed_calls_s", "error",
+                 *(f"error_{k}" for k in ERROR_PARTS), "engagement_time_s", "n_steps", "n_rhs_evals", "n_jacobian_evals")
 
 
 def write_rows(path, rows, columns=SWEEP_COLUMNS):

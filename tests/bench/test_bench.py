@@ -105,7 +105,7 @@ def test_summary_bound_adds_idas_summary_work_to_its_integrator_calls():
     # by hand, at the log-midpoints 1e-5 and 1e-7: IDAS's calls plus summary work sqrt(2.5 * 4) and
     # sqrt(4 * 6), Radau's wall time 20 and 80: sqrt(20 * 80 / sqrt(10 * 24)) / 40
     bound = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
-                                             work=("summary_work_s",))
+                                             bound="whole_over_floor_summary_bound")
     assert bound["whole_over_floor_summary_bound_vs_radau"] == pytest.approx(
         math.sqrt(20.0 * 80.0 / math.sqrt(240.0)) / 40.0, rel=1e-12)
     calls_only = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7))
@@ -122,14 +122,29 @@ def test_events_bound_adds_idas_event_work_to_its_calls_and_summary_work():
     # by hand, at the log-midpoints 1e-5 and 1e-7: IDAS's calls, summary and event work sqrt(3 * 4.5)
     # and sqrt(4.5 * 7), Radau's wall time 20 and 80: sqrt(20 * 80 / sqrt(13.5 * 31.5)) / 40
     bound = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
-                                             work=("summary_work_s", "event_work_s"))
+                                             bound="whole_over_floor_events_bound")
     assert bound["whole_over_floor_events_bound_vs_radau"] == pytest.approx(
         math.sqrt(20.0 * 80.0 / math.sqrt(13.5 * 31.5)) / 40.0, rel=1e-12)
     summary_only = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
-                                                    work=("summary_work_s",))
+                                                    bound="whole_over_floor_summary_bound")
     assert bound["whole_over_floor_events_bound_vs_radau"] < summary_only["whole_over_floor_summary_bound_vs_radau"]
     with pytest.raises(KeyError):                                   # only the bounds the bench reports
-        bench_run.whole_over_floor_bound(rows, entry, work=("event_work_s",))
+        bench_run.whole_over_floor_bound(rows, entry, bound="whole_over_floor_event_bound")
+
+
+def test_replay_bound_divides_by_the_replayed_calls_and_the_summary_arithmetic_alone():
+    rows = _rows({"idas": [(1e-4, 2.0, 1.0), (1e-6, 4.0, 2.5), (1e-8, 8.0, 4.0)],
+                  "Radau": [(1e-4, 10.0, 9.0), (1e-6, 40.0, 30.0), (1e-8, 160.0, 150.0)]})
+    for row, replayed, arithmetic in zip(rows, (1.2, 3.0, 5.0, 9.0, 9.0, 9.0), (0.3, 0.5, 1.0, 9.0, 9.0, 9.0)):
+        row["replayed_calls_s"], row["summary_arithmetic_s"] = replayed, arithmetic
+    entry = {"floor_speedup_vs_radau": 40.0}
+    # by hand, at the log-midpoints 1e-5 and 1e-7: IDAS's replayed calls plus summary arithmetic
+    # sqrt(1.5 * 3.5) and sqrt(3.5 * 6) (its integration time is part of the replay, not added),
+    # Radau's wall time 20 and 80: sqrt(20 * 80 / sqrt(5.25 * 21)) / 40
+    bound = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
+                                             bound="whole_over_floor_replay_bound")
+    assert bound == {"whole_over_floor_replay_bound_vs_radau": pytest.approx(
+        math.sqrt(20.0 * 80.0 / math.sqrt(5.25 * 21.0)) / 40.0, rel=1e-12)}
 
 
 def test_timed_runs_per_point():
@@ -315,24 +330,34 @@ def test_run_bench_end_to_end_writes_its_files(tmp_path, monkeypatch):
         if row["method"] == "idas":
             outside = float(row["wall_time_s"]) - float(row["integration_time_s"])
             assert 0 < float(row["event_work_s"]) < float(row["summary_work_s"]) < outside
+            # the replayed calls include the integrations; the summary's arithmetic is part of its work
+            assert float(row["integration_time_s"]) < float(row["replayed_calls_s"]) < float(row["wall_time_s"])
+            assert 0 < float(row["summary_arithmetic_s"]) < float(row["summary_work_s"])
         else:
-            assert row["summary_work_s"] == "" and row["event_work_s"] == ""
+            assert all(row[k] == "" for k in ("summary_work_s", "event_work_s", "summary_arithmetic_s",
+                                              "replayed_calls_s"))
     rows_written = [{**r, "error": float(r["error"]), "wall_time_s": float(r["wall_time_s"]),
                      "integration_time_s": float(r["integration_time_s"]),
                      "summary_work_s": float(r["summary_work_s"] or "nan"),
-                     "event_work_s": float(r["event_work_s"] or "nan")} for r in rows]
+                     "event_work_s": float(r["event_work_s"] or "nan"),
+                     "summary_arithmetic_s": float(r["summary_arithmetic_s"] or "nan"),
+                     "replayed_calls_s": float(r["replayed_calls_s"] or "nan")} for r in rows]
     for peer in ("radau", "lsoda"):       # the bound, recomputed from the written rows, is above whole / floor
         bound = bench_run.whole_over_floor_bound(rows_written, entry)[f"whole_over_floor_bound_vs_{peer}"]
         assert entry[f"whole_over_floor_bound_vs_{peer}"] == pytest.approx(bound, rel=1e-9)
         assert bound > entry[f"whole_over_floor_vs_{peer}"]      # integrator calls are part of the run
-        with_summary = bench_run.whole_over_floor_bound(rows_written, entry, work=("summary_work_s",))
+        with_summary = bench_run.whole_over_floor_bound(rows_written, entry, bound="whole_over_floor_summary_bound")
         key = f"whole_over_floor_summary_bound_vs_{peer}"
         assert entry[key] == pytest.approx(with_summary[key], rel=1e-9)
         assert entry[f"whole_over_floor_vs_{peer}"] < entry[key] < bound  # so is the summary work
-        with_events = bench_run.whole_over_floor_bound(rows_written, entry, work=("summary_work_s", "event_work_s"))
+        with_events = bench_run.whole_over_floor_bound(rows_written, entry, bound="whole_over_floor_events_bound")
         events_key = f"whole_over_floor_events_bound_vs_{peer}"
         assert entry[events_key] == pytest.approx(with_events[events_key], rel=1e-9)
         assert entry[f"whole_over_floor_vs_{peer}"] < entry[events_key] < entry[key]  # and the event checks
+        replay = bench_run.whole_over_floor_bound(rows_written, entry, bound="whole_over_floor_replay_bound")
+        replay_key = f"whole_over_floor_replay_bound_vs_{peer}"
+        assert entry[replay_key] == pytest.approx(replay[replay_key], rel=1e-9)
+        assert entry[f"whole_over_floor_vs_{peer}"] < entry[replay_key]   # the Python around the calls is not replayed
     assert written["single_run_s"] == {}          # bao2020 not among the scenes: not timed
     text = bench_run.format_summary(summary)
     assert "issue" not in text and "target" not in text and "integrator floor" in text
@@ -365,6 +390,8 @@ def test_sweep_methods_take_turns_at_each_tolerance(monkeypatch):
     monkeypatch.setattr(wp, "timed_run", timed_run)
     monkeypatch.setattr(wp, "summary_time", lambda run, count: (1e-4, None))
     monkeypatch.setattr(wp, "event_work_time", lambda run, count: 1e-5)
+    monkeypatch.setattr(wp, "summary_arithmetic_time", lambda run, count: 3e-5)
+    monkeypatch.setattr(wp, "run_replay_time", lambda scene, model, method, rtol, count: 1.5e-3)
     monkeypatch.setattr(wp, "trajectory_errors", lambda run, reference: dict.fromkeys(("max", *wp.ERROR_PARTS), 1e-6))
     scene = load_scene("zhang2021")
     methods, tolerances = ("idas", "cvodes", "Radau", "LSODA"), (1e-4, 1e-6, 1e-8)
@@ -375,7 +402,7 @@ def test_sweep_methods_take_turns_at_each_tolerance(monkeypatch):
     for row in res["rows"]:
         if row["method"] == "idas":        # three runs: 4, 3, 2 ms; the best, with its own run's statistics
             assert (row["wall_time_s"], row["cpu_time_s"], row["integration_time_s"]) == (2e-3, 4e-3, 1e-3)
-            assert row["event_work_s"] == 1e-5
+            assert (row["event_work_s"], row["summary_arithmetic_s"], row["replayed_calls_s"]) == (1e-5, 3e-5, 1.5e-3)
         elif row["method"] != "cvodes":    # one run
             assert row["wall_time_s"] == 4e-3
 

@@ -97,3 +97,13 @@ def test_summary_and_event_work_are_timed_on_one_run_and_the_spy_is_removed():
     assert row["whole_over_floor_calls_summary_events"] == pytest.approx(
         (row["idas_floor_ms"] / (calls + work + events)) * (row["radau_whole_ms"] / row["radau_floor_ms"]), rel=1e-12)
     assert row["whole_over_floor_calls_summary_events"] < row["whole_over_floor_calls_and_summary"]
+
+
+def test_replay_ratio_is_that_of_the_runs_own_calls_and_the_summary_arithmetic():
+    (row,) = _bench().measure("zhang2021", [1e-5], repeats=3, engines=["vm"])
+    assert row["replayed_calls"]["integrator"] == row["replayed_calls"]["integrator_stats"] > 0
+    assert row["whole_over_floor_calls_replayed"] == pytest.approx(
+        (row["idas_floor_ms"] / (row["replayed_calls_ms"] + row["parts_ms"]["summary"]))
+        * (row["radau_whole_ms"] / row["radau_floor_ms"]), rel=1e-12)
+    # the calls alone cost less than the run around them (its loop, setup and assembly are not replayed)
+    assert row["parts_ms"]["integrator_calls"] < row["replayed_calls_ms"] < row["timed_whole_ms"]

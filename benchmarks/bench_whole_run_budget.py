@@ -46,11 +46,12 @@ loop can skip while the grid detects the events: the event functions on every sa
 the ratio of a run made of its calls, the summary work and that event work.
 
 ``whole_over_floor_calls_replayed`` is the ratio of a run made of its own calls into compiled code,
-recorded on one run (:class:`clutchocp.bench.call_replay.CallRecorder`: the integrator calls and their statistics, the column
-functions on the grid or at one sample, other CasADi functions such as the consistent-initialisation
-Newton solve) and issued back to back from Python with nothing between them (``replayed_calls_ms``),
-plus the summary's own arithmetic (``parts_ms["summary"]``): what a Python engine that makes the same
-calls, so gives the same results, reaches with its hybrid loop, setup and assembly costing nothing.
+recorded on one run (:class:`clutchocp.bench.call_replay.CallRecorder`: the integrator calls and
+their statistics, the column functions on the grid or at one sample, other CasADi functions such as
+the consistent-initialisation Newton solve) and issued back to back from Python with nothing between
+them (``replayed_calls_ms``), plus the summary's own arithmetic (``parts_ms["summary"]``): what a
+Python engine that makes the same calls, so gives the same results, reaches with its hybrid loop,
+setup and assembly costing nothing (the bench's ``whole_over_floor_replay_bound_vs_radau``).
 
 The Radau run pays the same grid evaluations and summary after its integration. ``engine``: ``vm``
 (CasADi's virtual machine and numpy, the default) and ``native`` (the equations, outputs and event

@@ -96,55 +96,55 @@ def test_whole_over_floor_bound_is_whole_over_floor_over_the_integrator_share_of
         assert bound == pytest.approx(ratio / share, rel=1e-12) and bound >= ratio
 
 
-def test_summary_bound_adds_idas_summary_work_to_its_integrator_calls():
+def _idas_and_radau_rows(**columns):
+    """IDAS and Radau rows at errors 1e-4, 1e-6, 1e-8 (wall times 2, 4, 8 and 10, 40, 160 s; IDAS's
+    integration times 1, 2.5, 4 s), with extra ``columns`` (key -> six values, IDAS's rows first)."""
     rows = _rows({"idas": [(1e-4, 2.0, 1.0), (1e-6, 4.0, 2.5), (1e-8, 8.0, 4.0)],
                   "Radau": [(1e-4, 10.0, 9.0), (1e-6, 40.0, 30.0), (1e-8, 160.0, 150.0)]})
-    for row, work in zip(rows, (1.5, 1.5, 2.0, 9.0, 9.0, 9.0)):     # the peer's summary work is not read
-        row["summary_work_s"] = work
+    for key, values in columns.items():
+        for row, value in zip(rows, values):
+            row[key] = value
+    return rows
+
+
+def _radau_bound(rows, bound):
+    """The bound against Radau at the log-midpoints 1e-5 and 1e-7, floor speed-up 40."""
     entry = {"floor_speedup_vs_radau": 40.0}
+    return bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
+                                            bound=bound)[f"{bound}_vs_radau"]
+
+
+def test_summary_bound_adds_idas_summary_work_to_its_integrator_calls():
+    # the peer's summary work is not read
+    rows = _idas_and_radau_rows(summary_work_s=(1.5, 1.5, 2.0, 9.0, 9.0, 9.0))
     # by hand, at the log-midpoints 1e-5 and 1e-7: IDAS's calls plus summary work sqrt(2.5 * 4) and
     # sqrt(4 * 6), Radau's wall time 20 and 80: sqrt(20 * 80 / sqrt(10 * 24)) / 40
-    bound = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
-                                             bound="whole_over_floor_summary_bound")
-    assert bound["whole_over_floor_summary_bound_vs_radau"] == pytest.approx(
-        math.sqrt(20.0 * 80.0 / math.sqrt(240.0)) / 40.0, rel=1e-12)
-    calls_only = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7))
-    assert bound["whole_over_floor_summary_bound_vs_radau"] < calls_only["whole_over_floor_bound_vs_radau"]
+    bound = _radau_bound(rows, "whole_over_floor_summary_bound")
+    assert bound == pytest.approx(math.sqrt(20.0 * 80.0 / math.sqrt(240.0)) / 40.0, rel=1e-12)
+    assert bound < _radau_bound(rows, "whole_over_floor_bound")
     assert "calls_and_work_s" not in rows[0]                        # the rows are left as they were
 
 
 def test_events_bound_adds_idas_event_work_to_its_calls_and_summary_work():
-    rows = _rows({"idas": [(1e-4, 2.0, 1.0), (1e-6, 4.0, 2.5), (1e-8, 8.0, 4.0)],
-                  "Radau": [(1e-4, 10.0, 9.0), (1e-6, 40.0, 30.0), (1e-8, 160.0, 150.0)]})
-    for row, work, events in zip(rows, (1.5, 1.5, 2.0, 9.0, 9.0, 9.0), (0.5, 0.5, 1.0, 9.0, 9.0, 9.0)):
-        row["summary_work_s"], row["event_work_s"] = work, events
-    entry = {"floor_speedup_vs_radau": 40.0}
+    rows = _idas_and_radau_rows(summary_work_s=(1.5, 1.5, 2.0, 9.0, 9.0, 9.0),
+                                event_work_s=(0.5, 0.5, 1.0, 9.0, 9.0, 9.0))
     # by hand, at the log-midpoints 1e-5 and 1e-7: IDAS's calls, summary and event work sqrt(3 * 4.5)
     # and sqrt(4.5 * 7), Radau's wall time 20 and 80: sqrt(20 * 80 / sqrt(13.5 * 31.5)) / 40
-    bound = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
-                                             bound="whole_over_floor_events_bound")
-    assert bound["whole_over_floor_events_bound_vs_radau"] == pytest.approx(
-        math.sqrt(20.0 * 80.0 / math.sqrt(13.5 * 31.5)) / 40.0, rel=1e-12)
-    summary_only = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
-                                                    bound="whole_over_floor_summary_bound")
-    assert bound["whole_over_floor_events_bound_vs_radau"] < summary_only["whole_over_floor_summary_bound_vs_radau"]
+    bound = _radau_bound(rows, "whole_over_floor_events_bound")
+    assert bound == pytest.approx(math.sqrt(20.0 * 80.0 / math.sqrt(13.5 * 31.5)) / 40.0, rel=1e-12)
+    assert bound < _radau_bound(rows, "whole_over_floor_summary_bound")
     with pytest.raises(KeyError):                                   # only the bounds the bench reports
-        bench_run.whole_over_floor_bound(rows, entry, bound="whole_over_floor_event_bound")
+        _radau_bound(rows, "whole_over_floor_event_bound")
 
 
 def test_replay_bound_divides_by_the_replayed_calls_and_the_summary_arithmetic_alone():
-    rows = _rows({"idas": [(1e-4, 2.0, 1.0), (1e-6, 4.0, 2.5), (1e-8, 8.0, 4.0)],
-                  "Radau": [(1e-4, 10.0, 9.0), (1e-6, 40.0, 30.0), (1e-8, 160.0, 150.0)]})
-    for row, replayed, arithmetic in zip(rows, (1.2, 3.0, 5.0, 9.0, 9.0, 9.0), (0.3, 0.5, 1.0, 9.0, 9.0, 9.0)):
-        row["replayed_calls_s"], row["summary_arithmetic_s"] = replayed, arithmetic
-    entry = {"floor_speedup_vs_radau": 40.0}
+    rows = _idas_and_radau_rows(replayed_calls_s=(1.2, 3.0, 5.0, 9.0, 9.0, 9.0),
+                                summary_arithmetic_s=(0.3, 0.5, 1.0, 9.0, 9.0, 9.0))
     # by hand, at the log-midpoints 1e-5 and 1e-7: IDAS's replayed calls plus summary arithmetic
     # sqrt(1.5 * 3.5) and sqrt(3.5 * 6) (its integration time is part of the replay, not added),
     # Radau's wall time 20 and 80: sqrt(20 * 80 / sqrt(5.25 * 21)) / 40
-    bound = bench_run.whole_over_floor_bound(rows, entry, peers=("Radau",), levels=(1e-5, 1e-7),
-                                             bound="whole_over_floor_replay_bound")
-    assert bound == {"whole_over_floor_replay_bound_vs_radau": pytest.approx(
-        math.sqrt(20.0 * 80.0 / math.sqrt(5.25 * 21.0)) / 40.0, rel=1e-12)}
+    assert _radau_bound(rows, "whole_over_floor_replay_bound") == pytest.approx(
+        math.sqrt(20.0 * 80.0 / math.sqrt(5.25 * 21.0)) / 40.0, rel=1e-12)
 
 
 def test_timed_runs_per_point():

@@ -9,7 +9,6 @@ makes the same calls, and so gives the same results, costs at the very least.
 """
 
 import functools
-import math
 
 import numpy as np
 
@@ -104,7 +103,7 @@ def replay_time(recorder, repeats=5):
     """Best wall time [s] of ``repeats`` replays of the recorded calls (after one untimed replay)."""
     task = wall(recorder.replay)
     task()
-    return min((task()[0] for _ in range(max(1, repeats))), default=math.inf)
+    return min(task()[0] for _ in range(max(1, repeats)))
 
 
 def run_replay_time(scene, model, method, rtol, repeats=5):

@@ -26,8 +26,8 @@ every whole run pays whatever integrates it, and of its event work (its modes' e
 the samples it keeps: :mod:`clutchocp.bench.event_work`), which the floor, knowing its events,
 skips, of its summary's arithmetic alone (its outputs evaluated beforehand), and of the calls its run
 makes into compiled code replayed back to back (:mod:`clutchocp.bench.call_replay`): the least an
-engine in Python making the same calls costs. Times at matched error come from the Pareto front of each method's (error, time) points,
-interpolated in log-log (:func:`time_at_error`).
+engine in Python making the same calls costs. Times at matched error come from the Pareto front of
+each method's (error, time) points, interpolated in log-log (:func:`time_at_error`).
 """
 
 import itertools

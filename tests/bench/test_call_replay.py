@@ -43,7 +43,6 @@ def test_recorded_calls_are_the_runs_own_and_the_recorder_is_removed(zhang):
     seg = run_method(scene, model, "idas", 1e-5).result.segments[-1]
     cm = model.hybrid.compiled()[seg.mode]
     assert (last_state * cm.x_nominal).tolist() == [seg.x[name][-1] for name in cm.x_names]
-    assert replay_time(recorder, repeats=3) > 0
 
 
 def test_only_the_outermost_call_is_recorded_and_arrays_are_copied():
@@ -74,3 +73,21 @@ def test_summary_arithmetic_is_the_summary_without_its_evaluations(zhang):
     work, summary = summary_time(run, repeats=3)
     assert 0 < arithmetic < work
     assert summary["engagement_time_s"] == run.summary["engagement_time_s"]
+
+
+def test_replay_time_is_the_best_of_its_timed_replays_after_an_untimed_one():
+    class Recorder:
+        durations = [0.03, 0.02, 0.005, 0.02]     # the first replay is untimed: best of the other three
+
+        def __init__(self):
+            self.replays = 0
+
+        def replay(self):
+            import time
+            time.sleep(self.durations[self.replays])
+            self.replays += 1
+
+    recorder = Recorder()
+    best = replay_time(recorder, repeats=3)
+    assert recorder.replays == 4
+    assert 0.005 <= best < 0.02

@@ -27,13 +27,23 @@ a run makes it (its start, parameters, normalised time and output grid) and time
 
 ``whole_ms`` is a whole run's best time (``--repeats`` runs), ``ended_saving_share`` the part of it
 an ended first call would save (``(full - ended) / whole``): with every other time unchanged,
-``whole / floor`` would rise by the factor ``1 / (1 - share)``. Results go to
-``bench_first_call_stop.json`` in ``--out`` and a table to stdout. The three calls and the whole run
-take turns, one timed call each per round, after one untimed call each
+``whole / floor`` would rise by the factor ``1 / (1 - share)``.
+
+An engine can only end that call early by guessing: a call that ends before the event and a
+restart (IDAS or CVODES again at order 1 with a small first step; from there the quadratic
+prediction sees the crossing). ``restarts`` times whole runs whose blind first call ends after
+``1/k`` of the piece, ``k`` in ``--parts``, at the same tolerance, side by side with the run as it
+is; their samples move (the steps do), so each gets its error against a reference run
+(:func:`clutchocp.bench.workprecision.trajectory_errors`, IDAS at rtol 1e-12) next to the run's own
+(``whole_error``). ``restart_best_saving_share`` is the part of the whole run the best of them saves.
+
+Results go to ``bench_first_call_stop.json`` in ``--out`` and a table to stdout. The three calls
+and the whole runs take turns, one timed call each per round, after one untimed call each
 (:func:`clutchocp.bench.turns.best_of_turns`): the times a saving divides are taken side by side.
 """
 
 import argparse
+import contextlib
 import functools
 import json
 import sys
@@ -43,6 +53,7 @@ from pathlib import Path
 import numpy as np
 
 SCENES = ("zhang2021", "default_driveline", "default_driveline_thermal")
+PARTS = (2, 4, 8, 16)
 
 
 def first_call(scene, model, rtol):
@@ -66,6 +77,37 @@ def first_call(scene, model, rtol):
     finally:
         idas_path.IdasPath._integrate = inner
     return seen[0], run
+
+
+@contextlib.contextmanager
+def blind_first_call_ended(parts):
+    """The engine with the first call of a piece that predicts no crossing (it would run to the end
+    of the piece) ended after ``1 / parts`` of the piece's outputs; the next call restarts and is
+    planned as the engine plans it."""
+    import clutchocp.simulation.idas_path as idas_path
+
+    inner = idas_path.IdasPath._plan
+
+    def plan(path, cm, left, pu, times, monitor, probes, horizon=None, first=False):
+        n, t_probe, horizon = inner(path, cm, left, pu, times, monitor, probes, horizon, first)
+        if first and t_probe is None and horizon is None and n == times.size:
+            n = max(2, times.size // parts)
+        return n, t_probe, horizon
+
+    idas_path.IdasPath._plan = plan
+    try:
+        yield
+    finally:
+        idas_path.IdasPath._plan = inner
+
+
+def run_ended(scene, model, rtol, parts):
+    """A whole run (:func:`clutchocp.bench.workprecision.run_method`) with its blind first calls
+    ended after ``1 / parts`` of the piece."""
+    from clutchocp.bench.workprecision import run_method
+
+    with blind_first_call_ended(parts):
+        return run_method(scene, model, "idas", rtol)
 
 
 def delayed_events(cm, lag_tau):
@@ -104,12 +146,12 @@ def call_task(integrator, nx, nz, n, x0, z0, p):
     return task
 
 
-def measure(name, rtol, past, repeats):
+def measure(name, rtol, past, repeats, parts=PARTS):
     """One scene: a JSON-ready row."""
     import casadi as ca
 
     from clutchocp.bench.turns import best_of_turns, wall
-    from clutchocp.bench.workprecision import run_method
+    from clutchocp.bench.workprecision import REFERENCE_RTOL, run_method, trajectory_errors
     from clutchocp.engagement.model import EngagementModel
     from clutchocp.scene import load_scene
 
@@ -138,10 +180,17 @@ def measure(name, rtol, past, repeats):
             break
         past *= 2
     zero_dae = {**cm.dae_tau, "zero": delayed_events(cm, past / n)}
-    # the three calls and a whole run take turns, one timed call each per round
+    # the three calls and the whole runs take turns, one timed call each per round
     best = best_of_turns({"full": task(cm.dae_tau, taus), "ended": task(cm.dae_tau, taus[:min(n, before + past)]),
                           "zero": task(zero_dae, taus, {"max_events": 0}),
-                          "whole": wall(functools.partial(run_method, scene, model, "idas", rtol))}, repeats)
+                          "whole": wall(functools.partial(run_method, scene, model, "idas", rtol)),
+                          **{f"restart_{k}": wall(functools.partial(run_ended, scene, model, rtol, k)) for k in parts}},
+                         repeats)
+    reference = run_method(scene, model, "idas", REFERENCE_RTOL)
+    restarts = [{"parts": k, "whole_ms": 1e3 * best[f"restart_{k}"][0],
+                 "steps": int(best[f"restart_{k}"][1].summary["solver"]["statistics"]["n_steps"]),
+                 "error": trajectory_errors(best[f"restart_{k}"][1], reference)["max"]} for k in parts]
+    fastest = min(restarts, key=lambda r: r["whole_ms"]) if restarts else None
     full_s, (full_x, full_steps, _) = best["full"]
     ended_s, (ended_x, ended_steps, _) = best["ended"]
     zero_s, (zero_x, zero_steps, zero_message) = best["zero"]
@@ -158,6 +207,10 @@ def measure(name, rtol, past, repeats):
         "casadi_zero_message": zero_message,
         "zero_change": float(np.max(np.abs(zero_x[:, :kept] - full_x[:, :kept]))) if kept else None,
         "whole_ms": 1e3 * whole, "ended_saving_share": (full_s - ended_s) / whole,
+        "whole_steps": int(best["whole"][1].summary["solver"]["statistics"]["n_steps"]),
+        "whole_error": trajectory_errors(best["whole"][1], reference)["max"],
+        "restarts": restarts, "restart_best_parts": fastest["parts"] if fastest else None,
+        "restart_best_saving_share": 1.0 - fastest["whole_ms"] / (1e3 * whole) if fastest else None,
     }
 
 
@@ -167,8 +220,11 @@ def _line(row):
             f"{row['ended_ms']:.2f} ms ({row['ended_steps']} steps), samples changed {row['ended_change']:.1e}; "
             f"CasADi zero events: {row['casadi_zero_ms']:.2f} ms ({row['casadi_zero_steps']} steps, "
             f"{row['casadi_zero_written']} of {row['outputs']} samples written, {row['outputs_before_event']} before "
-            f"the event), samples changed {row['zero_change']:.1e}; whole run {row['whole_ms']:.2f} ms, an ended first "
-            f"call would save {100 * row['ended_saving_share']:.1f} % of it")
+            f"the event), samples changed {row['zero_change']:.1e}; whole run {row['whole_ms']:.2f} ms "
+            f"({row['whole_steps']} steps, error {row['whole_error']:.1e}), an ended first call would save "
+            f"{100 * row['ended_saving_share']:.1f} % of it; first call ended by a restart at "
+            + ", ".join(f"1/{r['parts']}: {r['whole_ms']:.2f} ms ({r['steps']} steps, error {r['error']:.1e})"
+                        for r in row["restarts"]))
 
 
 def main(argv=None):
@@ -178,6 +234,8 @@ def main(argv=None):
     parser.add_argument("--rtol", type=float, default=1e-7, help="integration tolerance (default 1e-7)")
     parser.add_argument("--past", type=int, default=5, help="grid intervals past the event an ended call keeps, first try (>= 1; doubled until its samples before the event are unchanged)")
     parser.add_argument("--repeats", type=int, default=15, help="timed calls and whole runs, the best counts")
+    parser.add_argument("--parts", default=",".join(map(str, PARTS)),
+                        help="whole runs whose blind first call ends after 1/k of the piece, k in this list (integers >= 2)")
     args = parser.parse_args(argv)
     if args.past < 1:
         parser.error(f"--past must be >= 1: the event location needs the sample after the crossing (got {args.past})")
@@ -185,9 +243,15 @@ def main(argv=None):
         parser.error(f"--repeats must be >= 1 (got {args.repeats})")
     if not 0 < args.rtol < 1:
         parser.error(f"--rtol must lie in (0, 1) (got {args.rtol})")
+    try:
+        parts = tuple(int(k) for k in args.parts.split(",")) if args.parts else ()
+    except ValueError:
+        parts = (0,)
+    if any(k < 2 for k in parts):
+        parser.error(f"--parts must be a comma-separated list of integers >= 2 (got {args.parts!r})")
     rows = []
     for name in args.scenes.split(","):
-        rows.append(measure(name, args.rtol, args.past, args.repeats))
+        rows.append(measure(name, args.rtol, args.past, args.repeats, parts))
         print(_line(rows[-1]), file=sys.stderr, flush=True)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -933,7 +933,7 @@ def r_first_call_restart(n):
     d = n["first_call_stop"]
     parts = [r["parts"] for r in d["rows"][0]["restarts"]] if d["rows"] else []
     rows = []
-    for r in d["rows"]:
+    for r in (r for r in d["rows"] if r["restarts"]):
         fastest = next(x for x in r["restarts"] if x["parts"] == r["restart_best_parts"])
         rows.append((f"`{r['scene']}`", f"{r['whole_ms']:.2f} ({r['whole_steps']})", fmt(r["whole_error"], 2),
                      *(f"{x['whole_ms']:.2f} ({x['steps']})" for x in r["restarts"]),

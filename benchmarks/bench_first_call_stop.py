@@ -35,7 +35,9 @@ prediction sees the crossing). ``restarts`` times whole runs whose blind first c
 ``1/k`` of the piece, ``k`` in ``--parts``, at the same tolerance, side by side with the run as it
 is; their samples move (the steps do), so each gets its error against a reference run
 (:func:`clutchocp.bench.workprecision.trajectory_errors`, IDAS at rtol 1e-12) next to the run's own
-(``whole_error``). ``restart_best_saving_share`` is the part of the whole run the best of them saves.
+(``whole_error``), and where its first call ends (``first_call_end_s``, ``ends_past_event``: a call
+ending past the event finds it without a restart). ``restart_best_saving_share`` is the part of the
+whole run the best of them saves.
 
 Results go to ``bench_first_call_stop.json`` in ``--out`` and a table to stdout. The three calls
 and the whole runs take turns, one timed call each per round, after one untimed call each
@@ -188,6 +190,8 @@ def measure(name, rtol, past, repeats, parts=PARTS):
                          repeats)
     reference = run_method(scene, model, "idas", REFERENCE_RTOL)
     restarts = [{"parts": k, "whole_ms": 1e3 * best[f"restart_{k}"][0],
+                 "first_call_end_s": float(times[max(2, n // k) - 1]),      # where the ended first call ends
+                 "ends_past_event": bool(times[max(2, n // k) - 1] > event.t),
                  "steps": int(best[f"restart_{k}"][1].summary["solver"]["statistics"]["n_steps"]),
                  "error": trajectory_errors(best[f"restart_{k}"][1], reference)["max"]} for k in parts]
     fastest = min(restarts, key=lambda r: r["whole_ms"]) if restarts else None

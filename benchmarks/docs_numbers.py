@@ -936,16 +936,26 @@ def r_first_call_restart(n):
     for r in (r for r in d["rows"] if r["restarts"]):
         fastest = next(x for x in r["restarts"] if x["parts"] == r["restart_best_parts"])
         rows.append((f"`{r['scene']}`", f"{r['whole_ms']:.2f} ({r['whole_steps']})", fmt(r["whole_error"], 2),
-                     *(f"{x['whole_ms']:.2f} ({x['steps']})" for x in r["restarts"]),
+                     *(f"{x['whole_ms']:.2f} ({x['steps']}){'' if x['ends_past_event'] else ' *'}" for x in r["restarts"]),
                      f"1/{r['restart_best_parts']}", fmt(fastest["error"], 2),
                      f"{100 * r['restart_best_saving_share']:.1f} %", f"{1 / (1 - r['restart_best_saving_share']):.2f}"))
     rtols = sorted({r["rtol"] for r in d["rows"]})
-    return (table(("scene", "whole run: ms (steps)", "its error",
+    ended = [r for r in d["rows"] if r["restarts"]]
+    fastest_past = [r["scene"] for r in ended
+                    if next(x for x in r["restarts"] if x["parts"] == r["restart_best_parts"])["ends_past_event"]]
+    short_slower = [f"1/{x['parts']} on {r['scene']}" for r in ended for x in r["restarts"]
+                    if not x["ends_past_event"] and x["whole_ms"] > r["whole_ms"]]
+    verdict = ("On every scene the fastest guess is one whose first call ends past the event, so that finds it "
+               "with no restart at all" if len(fastest_past) == len(ended) else
+               "The fastest guess ends past the event, with no restart, on " + (", ".join(fastest_past) or "no scene"))
+    verdict += (("; guesses that fall short of the event and restart are slower than the engine's own run: "
+                 + ", ".join(short_slower)) if short_slower else "") + ".\n\n"
+    return (verdict + table(("scene", "whole run: ms (steps)", "its error",
                    *(f"first call ended at 1/{k} of the piece: ms (steps)" for k in parts),
                    "fastest", "its error", "saves", "whole / floor factor"), rows)
             + f"\n(rtol {', '.join(f'{r:g}' for r in rtols)}; whole runs, the engine's and those whose first call of the "
               "slipping piece ends after 1/k of the piece, then restarts, taking turns with the calls of the table "
-              "above, best of 15 each; error: the largest relative error against IDAS at rtol 1e-12 (speeds, film "
+              "above, best of 15 each; *: the first call ends before the event and restarts; error: the largest relative error against IDAS at rtol 1e-12 (speeds, film "
               "gaps, lock-up time and torque jump, as in the work-precision sweep); whole / floor factor: "
               f"1 / (1 - saving); `{d['command']}`; {measured(n, 'first_call_stop')}.)\n")
 

@@ -31,11 +31,13 @@ def test_an_ended_first_call_keeps_its_samples_and_saves_steps():
     assert all(r["steps"] != row["whole_steps"] for r in row["restarts"])
     assert 0.0 < row["whole_error"] < 1e-5
     assert all(r["error"] < 3.0 * row["whole_error"] for r in row["restarts"])
+    # zhang2021 locks at 1.6 s of 6 s: half the piece ends past the event, an eighth before it
+    assert [(r["first_call_end_s"], r["ends_past_event"]) for r in row["restarts"]] == [(3.0, True), (0.75, False)]
     fastest = min(r["whole_ms"] for r in row["restarts"])
     assert row["restart_best_saving_share"] == 1.0 - fastest / row["whole_ms"]
 
 
-def test_a_blind_first_call_ends_at_the_part_asked_for():
+def test_a_blind_first_call_ends_at_the_part_asked_for(monkeypatch):
     bench = _bench()
     from clutchocp.bench.workprecision import run_method
     from clutchocp.engagement.model import EngagementModel
@@ -50,14 +52,11 @@ def test_a_blind_first_call_ends_at_the_part_asked_for():
         sizes.append(len(times))
         return inner(path, cm, t0, xs0, zs0, pu, times)
 
-    IdasPath._integrate = spy
-    try:
-        as_is = run_method(scene, model, "idas", 1e-7)
-        first_as_is = sizes[0]
-        sizes.clear()
-        ended = bench.run_ended(scene, model, 1e-7, 4)
-    finally:
-        IdasPath._integrate = inner
+    monkeypatch.setattr(IdasPath, "_integrate", spy)
+    as_is = run_method(scene, model, "idas", 1e-7)
+    first_as_is = sizes[0]
+    sizes.clear()
+    ended = bench.run_ended(scene, model, 1e-7, 4)
     assert sizes[0] == first_as_is // 4                       # the first call: a quarter of the piece's outputs
     stats, stats_as_is = ended.summary["solver"]["statistics"], as_is.summary["solver"]["statistics"]
     assert stats["n_integrator_calls"] > stats_as_is["n_integrator_calls"]
